@@ -1,0 +1,5 @@
+"""The harvest arm world (not yet built)."""
+
+from __future__ import annotations
+
+REGISTRATIONS: tuple[dict, ...] = ()
