@@ -1,0 +1,1 @@
+"""Training, evaluation, comparison and the ``motiongym`` command."""

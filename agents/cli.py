@@ -1,0 +1,216 @@
+"""The ``motiongym`` command: list, evaluate, compare, train, reproduce, bench.
+
+Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
+malformed YAML file, a model built for another space) ends in one line on
+standard error that names the problem and the valid choices, and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from motiongym.agents.environments import check_env_id, make_env, short_name
+from motiongym.agents.errors import UsageError
+from motiongym.baselines.registry import UnknownPolicyError
+from motiongym.envs import ENV_IDS
+
+DEFAULT_EPISODES = 10
+
+
+def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
+    """``["dof=5", "map=maze"]`` -> ``{"dof": 5, "map": "maze"}`` (values read as YAML)."""
+    kwargs = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair!r}")
+        kwargs[key] = yaml.safe_load(value)
+    return kwargs
+
+
+def _evaluations(env_id, policies, args):
+    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.predictors import load_predictor, policy_label
+
+    env_kwargs = _env_kwargs(args.env_kwargs)
+    env = make_env(env_id, env_kwargs)
+    seeds = range(args.seed, args.seed + args.episodes)
+    results = []
+    for policy in policies:
+        predictor = load_predictor(policy, env_id, env, env_kwargs)
+        label = policy_label(policy)
+        results.append(evaluate(env, predictor, seeds, env_id, label, not args.no_progress))
+    env.close()
+    return results
+
+
+def cmd_list(args: argparse.Namespace) -> None:
+    from rich.table import Table
+
+    from motiongym.agents.predictors import available_policies
+    from motiongym.agents.report import console
+
+    table = Table(title="motiongym environments")
+    table.add_column("ID")
+    table.add_column("policies")
+    for env_id in ENV_IDS:
+        table.add_row(env_id, ", ".join(available_policies(env_id)) or "-")
+    console.print(table)
+
+
+def cmd_evaluate(args: argparse.Namespace) -> None:
+    from motiongym.agents.report import console, summary_table
+
+    check_env_id(args.env_id)
+    (evaluation,) = _evaluations(args.env_id, [args.policy], args)
+    console.print(summary_table(evaluation))
+    stem = f"{short_name(args.env_id)}_{evaluation.policy}"
+    for path in evaluation.write(args.out, stem):
+        console.print(f"wrote {path}")
+
+
+def cmd_compare(args: argparse.Namespace) -> None:
+    from motiongym.agents.predictors import available_policies
+    from motiongym.agents.report import comparison_table, console, write_comparison
+
+    if args.all == (args.env_id is not None):
+        raise UsageError("compare takes an environment ID or --all, not both")
+    env_ids = ENV_IDS if args.all else [check_env_id(args.env_id)]
+    for env_id in env_ids:
+        policies = args.policies or available_policies(env_id)
+        if not policies:
+            console.print(f"{env_id}: no policies to compare")
+            continue
+        evaluations = _evaluations(env_id, policies, args)
+        console.print(comparison_table(evaluations))
+        for path in write_comparison(evaluations, args.out, short_name(env_id)):
+            console.print(f"wrote {path}")
+
+
+def cmd_train(args: argparse.Namespace) -> None:
+    from motiongym.agents.report import console
+    from motiongym.agents.train import train
+
+    run_dir = train(
+        args.env_id,
+        args.algo,
+        config_path=args.config,
+        seed=args.seed,
+        out_root=args.out,
+        n_timesteps=args.timesteps,
+        progress=not args.no_progress,
+    )
+    console.print(f"run folder: {run_dir}")
+
+
+def cmd_reproduce(args: argparse.Namespace) -> None:
+    from motiongym.agents.reproduce import reproduce
+
+    reproduce(args.experiment, args.out / args.experiment, quick=args.quick)
+
+
+def cmd_bench(args: argparse.Namespace) -> None:
+    from motiongym.agents.bench import bench
+
+    bench(args.out, quick=args.quick, env_ids=args.ids or None)
+
+
+def _evaluation_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--episodes",
+        type=int,
+        default=DEFAULT_EPISODES,
+        help=f"episodes per policy (default {DEFAULT_EPISODES})",
+    )
+    parser.add_argument(
+        "--seed",
+        type=int,
+        default=100_000,
+        help="seed of the first episode; episode i uses seed+i (default 100000)",
+    )
+    parser.add_argument(
+        "--env-kwargs",
+        nargs="*",
+        default=[],
+        metavar="KEY=VALUE",
+        help="keywords for gym.make, values read as YAML",
+    )
+    parser.add_argument("--out", type=Path, default=Path("results"), help="output folder")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from motiongym.agents.predictors import algorithm_classes
+    from motiongym.agents.reproduce import EXPERIMENTS
+
+    parser = argparse.ArgumentParser(
+        prog="motiongym", description="Scripted and learned control of classic robot motion tasks."
+    )
+    commands = parser.add_subparsers(dest="command", required=True)
+
+    listing = commands.add_parser("list", help="environment IDs and their policies")
+    listing.set_defaults(handler=cmd_list)
+
+    evaluate = commands.add_parser("evaluate", help="run one policy on seeded episodes")
+    evaluate.add_argument("env_id", help="environment ID, e.g. motiongym/Sweeper-v0")
+    evaluate.add_argument(
+        "--policy",
+        required=True,
+        help="a scripted or shipped policy's name, a model .zip or a run folder",
+    )
+    _evaluation_options(evaluate)
+    evaluate.set_defaults(handler=cmd_evaluate)
+
+    compare = commands.add_parser("compare", help="run several policies on the same seeds")
+    compare.add_argument("env_id", nargs="?", help="environment ID (or --all)")
+    compare.add_argument("--all", action="store_true", help="every registered ID")
+    compare.add_argument(
+        "--policies",
+        nargs="+",
+        help="names or model paths (default: every scripted and shipped policy)",
+    )
+    _evaluation_options(compare)
+    compare.set_defaults(handler=cmd_compare)
+
+    train = commands.add_parser("train", help="train an SB3 algorithm from configs/")
+    train.add_argument("env_id", help="environment ID")
+    train.add_argument("--algo", default="ppo", choices=sorted(algorithm_classes()))
+    train.add_argument("--config", type=Path, help="YAML file (default: configs/<Name>-vN.yml)")
+    train.add_argument("--seed", type=int, default=0)
+    train.add_argument("--timesteps", type=int, help="override the config's n_timesteps")
+    train.add_argument("--out", type=Path, default=Path("runs"), help="where run folders go")
+    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.set_defaults(handler=cmd_train)
+
+    reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")
+    reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))
+    reproduce.add_argument("--quick", action="store_true", help="reduced protocol")
+    reproduce.add_argument("--out", type=Path, default=Path("results/reproduce"))
+    reproduce.set_defaults(handler=cmd_reproduce)
+
+    bench = commands.add_parser("bench", help="throughput against references in the same run")
+    bench.add_argument("ids", nargs="*", help="environment IDs (default: all)")
+    bench.add_argument("--quick", action="store_true", help="shorter timings")
+    bench.add_argument("--out", type=Path, default=Path("results/bench"))
+    bench.set_defaults(handler=cmd_bench)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.handler(args)
+    except (UsageError, UnknownPolicyError) as error:
+        print(f"motiongym: error: {error}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

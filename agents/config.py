@@ -1,0 +1,125 @@
+"""Training configurations: YAML in ``configs/``, one file per environment ID.
+
+A file ``configs/<Name>-vN.yml`` (rl-baselines3-zoo style) holds one block
+per algorithm (``ppo``, ``sac``, ``maskableppo``, ...). A block's keys are
+either the run settings below or keyword arguments of the algorithm's
+constructor (``learning_rate``, ``n_steps``, ...); any other key is rejected
+with its name. ``policy_kwargs`` is a mapping, never code: the activation
+function is named (``tanh``, ``relu``, ``elu``, ``leaky_relu``).
+
+Run settings:
+
+============== ===================================================== ==========
+key            meaning                                               default
+============== ===================================================== ==========
+n_envs         parallel environments                                 1
+n_timesteps    environment steps to train for                        required
+policy         SB3 policy name (``MlpPolicy``, ``MultiInputPolicy``) required
+policy_kwargs  network and activation (mapping)                      {}
+env_kwargs     keywords for ``gym.make``                             {}
+normalize      VecNormalize: false, true, or a mapping of its kwargs false
+vec_env        ``dummy`` or ``subproc``                              dummy
+eval_freq      steps between evaluations (over all envs)             10000
+n_eval_episodes episodes per evaluation                              5
+checkpoint_freq steps between checkpoints (over all envs)            50000
+============== ===================================================== ==========
+"""
+
+from __future__ import annotations
+
+import inspect
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from motiongym.agents.environments import short_name
+from motiongym.agents.errors import UsageError
+from motiongym.agents.predictors import algorithm_classes
+
+RUN_SETTINGS: dict[str, Any] = {
+    "n_envs": 1,
+    "n_timesteps": None,
+    "policy": None,
+    "policy_kwargs": {},
+    "env_kwargs": {},
+    "normalize": False,
+    "vec_env": "dummy",
+    "eval_freq": 10_000,
+    "n_eval_episodes": 5,
+    "checkpoint_freq": 50_000,
+}
+REQUIRED = ("n_timesteps", "policy")
+ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
+# Constructor arguments the run itself provides.
+_PROVIDED = {
+    "self",
+    "policy",
+    "env",
+    "policy_kwargs",
+    "tensorboard_log",
+    "seed",
+    "device",
+    "verbose",
+    "_init_setup_model",
+}
+
+
+def default_config_path(env_id: str) -> Path:
+    """The shipped configuration file of ``env_id``."""
+    return Path(str(resources.files("motiongym.configs") / f"{short_name(env_id)}.yml"))
+
+
+def load_config(path: Path, algo: str) -> dict[str, Any]:
+    """The validated block ``algo`` of the YAML file at ``path``, defaults filled in."""
+    if not path.is_file():
+        raise UsageError(f"no configuration file at {path}")
+    try:
+        document = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as error:
+        problem = " ".join(str(error).split())
+        raise UsageError(f"malformed YAML in {path}: {problem}") from error
+    if not isinstance(document, dict):
+        raise UsageError(f"{path} must map algorithm names to blocks of settings")
+    if algo not in document:
+        raise UsageError(
+            f"{path} has no block for algorithm {algo!r}; blocks: {', '.join(document)}"
+        )
+    return validate_block(document[algo], algo, f"{path} [{algo}]")
+
+
+def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
+    """Check one algorithm block's keys and types; return it with defaults."""
+    classes = algorithm_classes()
+    if algo not in classes:
+        raise UsageError(f"unknown algorithm {algo!r}; valid: {', '.join(classes)}")
+    if not isinstance(block, dict):
+        raise UsageError(f"{where} must be a mapping of settings")
+    constructor = set(inspect.signature(classes[algo].__init__).parameters) - _PROVIDED
+    unknown = set(block) - set(RUN_SETTINGS) - constructor
+    if unknown:
+        valid = sorted(set(RUN_SETTINGS) | constructor)
+        raise UsageError(
+            f"unknown key {sorted(unknown)[0]!r} in {where}; valid keys: {', '.join(valid)}"
+        )
+    config = {**RUN_SETTINGS, **block}
+    for key in REQUIRED:
+        if config[key] is None:
+            raise UsageError(f"{where} needs {key!r}")
+    for key in ("policy_kwargs", "env_kwargs"):
+        if not isinstance(config[key], dict):
+            raise UsageError(f"{where}: {key!r} must be a mapping")
+    activation = config["policy_kwargs"].get("activation_fn", "tanh")
+    if activation not in ACTIVATIONS:
+        raise UsageError(
+            f"{where}: activation_fn {activation!r} unknown; valid: {', '.join(ACTIVATIONS)}"
+        )
+    if config["vec_env"] not in ("dummy", "subproc"):
+        raise UsageError(f"{where}: vec_env must be 'dummy' or 'subproc'")
+    return config
+
+
+def algorithm_kwargs(config: dict[str, Any]) -> dict[str, Any]:
+    """The block's keys that go to the algorithm's constructor."""
+    return {key: value for key, value in config.items() if key not in RUN_SETTINGS}

@@ -1,0 +1,135 @@
+"""Running a predictor on seeded episodes and summarising what ``info`` reports.
+
+Episode ``i`` of an evaluation is reset with ``seed + i``: every policy run
+with the same ``seed`` and ``n_episodes`` faces the same scenarios.
+
+What is measured: the episode's return and length, and every key of the
+environment's ``metadata["info_measures"]`` (``{key: how}``, how being
+``last``, ``sum``, ``mean``, ``min`` or ``max`` over the episode's steps; the
+reset's ``info`` is not a step and is not counted). An environment that
+declares none reports its return and length only.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from tqdm.auto import tqdm
+
+from motiongym.agents.errors import UsageError
+
+AGGREGATIONS: dict[str, Callable[[np.ndarray], float]] = {
+    "last": lambda values: float(values[-1]),
+    "sum": lambda values: float(np.sum(values)),
+    "mean": lambda values: float(np.mean(values)),
+    "min": lambda values: float(np.min(values)),
+    "max": lambda values: float(np.max(values)),
+}
+
+
+def info_measures(env: gym.Env) -> dict[str, str]:
+    """The environment's declared ``{info key: aggregation}``, validated."""
+    measures = dict(env.unwrapped.metadata.get("info_measures", {}))
+    for key, how in measures.items():
+        if how not in AGGREGATIONS:
+            raise ValueError(
+                f"info measure {key!r} aggregates by {how!r}; valid: {', '.join(AGGREGATIONS)}"
+            )
+    return measures
+
+
+def run_episode(env: gym.Env, predictor: Any, seed: int) -> dict[str, float]:
+    """One episode from ``reset(seed=seed)``; its return, length and measures."""
+    measures = info_measures(env)
+    observation, _ = env.reset(seed=seed)
+    state, episode_start = None, np.ones(1, dtype=bool)
+    trace: dict[str, list[float]] = {key: [] for key in measures}
+    episode_return, length, done = 0.0, 0, False
+    while not done:
+        action, state = predictor.predict(
+            observation, state=state, episode_start=episode_start, deterministic=True
+        )
+        observation, reward, terminated, truncated, info = env.step(action)
+        episode_start = np.zeros(1, dtype=bool)
+        episode_return += float(reward)
+        length += 1
+        done = terminated or truncated
+        for key in measures:
+            trace[key].append(float(info[key]))
+    result = {"seed": seed, "return": episode_return, "length": length}
+    for key, how in measures.items():
+        result[key] = AGGREGATIONS[how](np.asarray(trace[key]))
+    return result
+
+
+@dataclass
+class Evaluation:
+    """The episodes of one policy on one environment ID."""
+
+    env_id: str
+    policy: str
+    episodes: list[dict[str, float]] = field(default_factory=list)
+
+    @property
+    def measures(self) -> list[str]:
+        return [key for key in self.episodes[0] if key != "seed"] if self.episodes else []
+
+    def summary(self) -> dict[str, dict[str, float]]:
+        """Mean, standard deviation, 95 % interval half-width, min and max per measure."""
+        table = {}
+        for key in self.measures:
+            values = np.array([episode[key] for episode in self.episodes])
+            half_width = 1.96 * values.std(ddof=1) / np.sqrt(len(values)) if len(values) > 1 else 0
+            table[key] = {
+                "mean": float(values.mean()),
+                "std": float(values.std()),
+                "ci95": float(half_width),
+                "min": float(values.min()),
+                "max": float(values.max()),
+            }
+        return table
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "env_id": self.env_id,
+            "policy": self.policy,
+            "seeds": [episode["seed"] for episode in self.episodes],
+            "summary": self.summary(),
+            "episodes": self.episodes,
+        }
+
+    def write(self, out_dir: Path, stem: str) -> list[Path]:
+        """Write ``stem.json`` (summary and episodes) and ``stem.csv`` (episodes)."""
+        out_dir.mkdir(parents=True, exist_ok=True)
+        json_path, csv_path = out_dir / f"{stem}.json", out_dir / f"{stem}.csv"
+        json_path.write_text(json.dumps(self.to_json(), indent=2))
+        with csv_path.open("w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=list(self.episodes[0]))
+            writer.writeheader()
+            writer.writerows(self.episodes)
+        return [json_path, csv_path]
+
+
+def evaluate(
+    env: gym.Env,
+    predictor: Any,
+    seeds: Iterable[int],
+    env_id: str,
+    policy: str,
+    progress: bool = True,
+) -> Evaluation:
+    """Run ``predictor`` once from each seed; the episodes as an :class:`Evaluation`."""
+    seeds = list(seeds)
+    if not seeds:
+        raise UsageError("at least one episode is needed")
+    evaluation = Evaluation(env_id, policy)
+    for seed in tqdm(seeds, desc=f"{policy} on {env_id}", disable=not progress, leave=False):
+        evaluation.episodes.append(run_episode(env, predictor, seed))
+    return evaluation

@@ -1,0 +1,130 @@
+"""Turning a policy name or a model path into an SB3-style predictor.
+
+A *predictor* is anything with SB3's ``predict(observation, state,
+episode_start, deterministic)``: a scripted policy from
+:mod:`motiongym.baselines`, or a trained SB3 model. A policy is named by
+
+* a scripted policy's name declared for the environment ID (``psa-cwa``);
+* a trained model: a ``.zip`` written by SB3, or a run folder written by
+  ``motiongym train`` (holding ``model.zip`` and, if the run normalised
+  observations, ``vecnormalize.pkl``, which is applied here).
+
+The algorithm of a bare ``.zip`` is read from the policy class saved in it
+(PPO and A2C share theirs, and either predicts the same way).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.save_util import load_from_zip_file
+from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+from motiongym.agents.environments import resolved_env_kwargs
+from motiongym.agents.errors import UsageError
+from motiongym.agents.pretrained import pretrained_models, verify_manifest
+from motiongym.baselines import make_policy, scripted_policies
+
+MODEL_FILE = "model.zip"
+NORMALIZATION_FILE = "vecnormalize.pkl"
+
+
+def algorithm_classes() -> dict[str, type[BaseAlgorithm]]:
+    """The SB3 and sb3-contrib algorithms by lower-case name."""
+    from sb3_contrib import TQC, MaskablePPO, RecurrentPPO
+    from stable_baselines3 import A2C, DQN, PPO, SAC, TD3
+
+    classes = [PPO, A2C, SAC, TD3, DQN, MaskablePPO, RecurrentPPO, TQC]
+    return {cls.__name__.lower(): cls for cls in classes}
+
+
+class NormalizedModel:
+    """A trained model behind the observation normalisation it was trained with."""
+
+    def __init__(self, model: BaseAlgorithm, normalization: VecNormalize) -> None:
+        self.model = model
+        self.normalization = normalization
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        observation = self.normalization.normalize_obs(observation)
+        return self.model.predict(observation, state, episode_start, deterministic)
+
+
+def model_path(path: Path) -> Path:
+    """The model file of a path that is a ``.zip`` or a run folder."""
+    candidate = path / MODEL_FILE if path.is_dir() else path
+    if not candidate.is_file():
+        raise UsageError(f"no model file at {candidate}")
+    return candidate
+
+
+def saved_algorithm(path: Path) -> type[BaseAlgorithm]:
+    """The algorithm class able to load the SB3 model saved at ``path``."""
+    try:
+        data, _, _ = load_from_zip_file(path, device="cpu", print_system_info=False)
+    except Exception as error:  # a corrupt or foreign file: name it
+        raise UsageError(f"{path} is not a Stable-Baselines3 model file ({error})") from error
+    policy_module = getattr((data or {}).get("policy_class"), "__module__", "?")
+    # The first algorithm whose policies live in that module (PPO before A2C).
+    for algorithm in algorithm_classes().values():
+        if any(cls.__module__ == policy_module for cls in algorithm.policy_aliases.values()):
+            return algorithm
+    raise UsageError(f"{path}: no known algorithm saves policies from {policy_module!r}")
+
+
+def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
+    """Load a trained model and check it was built for ``env``'s spaces."""
+    file = model_path(path)
+    model = saved_algorithm(file).load(file, device="cpu")
+    for kind in ("observation_space", "action_space"):
+        trained, expected = getattr(model, kind), getattr(env, kind)
+        if trained != expected:
+            raise UsageError(
+                f"model {file} was trained for another {kind.replace('_', ' ')}: "
+                f"{trained} (the {env_id} environment has {expected})"
+            )
+    normalization_file = file.parent / NORMALIZATION_FILE
+    if not normalization_file.is_file():
+        return model
+    venv = DummyVecEnv([lambda: env])
+    normalization = VecNormalize.load(str(normalization_file), venv)
+    normalization.training = False
+    normalization.norm_reward = False
+    return NormalizedModel(model, normalization)
+
+
+def available_policies(env_id: str) -> list[str]:
+    """The names ``load_predictor`` accepts for ``env_id`` besides paths."""
+    return sorted(scripted_policies(env_id)) + sorted(pretrained_models(env_id))
+
+
+def load_predictor(
+    policy: str, env_id: str, env: gym.Env, env_kwargs: dict[str, Any] | None = None
+) -> Any:
+    """A predictor from a scripted policy's name, a shipped model's name, or a path."""
+    if policy in scripted_policies(env_id):
+        kwargs = resolved_env_kwargs(env_id, env_kwargs)
+        return make_policy(env_id, policy, env.observation_space, env.action_space, kwargs)
+    shipped = pretrained_models(env_id)
+    if policy in shipped:
+        verify_manifest(shipped[policy])
+        return load_model(shipped[policy], env, env_id)
+    path = Path(policy)
+    if path.exists():
+        return load_model(path, env, env_id)
+    choices = ", ".join(available_policies(env_id)) or "none"
+    raise UsageError(
+        f"unknown policy {policy!r} for {env_id}: not one of the policies ({choices}) "
+        "nor an existing model file or run folder"
+    )
+
+
+def policy_label(policy: str) -> str:
+    """A short name for a policy in tables: a model's run folder, or the name."""
+    path = Path(policy)
+    if path.suffix == ".zip":
+        return path.parent.name if path.name == MODEL_FILE else path.stem
+    return path.name if path.exists() else policy

@@ -1,0 +1,60 @@
+"""The trained models shipped in ``agents/pretrained/``.
+
+Layout: ``pretrained/<Name>-vN/<algo>/`` holds a run folder's ``model.zip``,
+``config.yml``, ``command.txt``, ``metrics.json``, optionally
+``vecnormalize.pkl``, and ``manifest.json``: the SHA-256 of every other file.
+The manifest is checked before a model is used.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from importlib import resources
+from pathlib import Path
+
+from motiongym.agents.environments import short_name
+from motiongym.agents.errors import UsageError
+
+MANIFEST = "manifest.json"
+
+
+def pretrained_root() -> Path:
+    return Path(str(resources.files("motiongym.agents") / "pretrained"))
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def write_manifest(folder: Path) -> Path:
+    """Record the SHA-256 of every file of ``folder`` (but the manifest)."""
+    digests = {
+        p.name: sha256(p) for p in sorted(folder.iterdir()) if p.is_file() and p.name != MANIFEST
+    }
+    path = folder / MANIFEST
+    path.write_text(json.dumps(digests, indent=2) + "\n")
+    return path
+
+
+def verify_manifest(folder: Path) -> None:
+    """Raise :class:`UsageError` unless every file matches the manifest."""
+    manifest = folder / MANIFEST
+    if not manifest.is_file():
+        raise UsageError(f"{folder} has no {MANIFEST}")
+    for name, digest in json.loads(manifest.read_text()).items():
+        path = folder / name
+        if not path.is_file():
+            raise UsageError(f"{path} is listed in {manifest} but missing")
+        if sha256(path) != digest:
+            raise UsageError(f"{path} does not match its SHA-256 in {manifest}")
+
+
+def pretrained_models(env_id: str) -> dict[str, Path]:
+    """``{label: folder}`` of the models shipped for ``env_id`` (label ``<algo>``)."""
+    root = pretrained_root() / short_name(env_id)
+    if not root.is_dir():
+        return {}
+    return {
+        folder.name: folder for folder in sorted(root.iterdir()) if (folder / "model.zip").is_file()
+    }

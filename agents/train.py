@@ -1,0 +1,168 @@
+"""Training an SB3 algorithm on an environment ID from a ``configs/`` block.
+
+A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
+
+* ``model.zip``: the final model; ``vecnormalize.pkl`` if the run normalised;
+* ``config.yml``: the resolved block, with the ID, algorithm and seed;
+* ``command.txt``: the command that made the run;
+* ``eval/``: ``evaluations.npz`` and ``best_model.zip`` (SB3's EvalCallback),
+  ``learning_curve.png`` (mean evaluation return against steps);
+* ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs).
+
+Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
+callback's environment ``seed + 10_000``. Evaluation suites use seeds from
+``EVALUATION_SEED`` up, far from both.
+"""
+
+from __future__ import annotations
+
+import shlex
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+import yaml
+from matplotlib.figure import Figure
+from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
+from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
+
+from motiongym.agents.config import algorithm_kwargs, default_config_path, load_config
+from motiongym.agents.environments import check_env_id, short_name
+from motiongym.agents.predictors import MODEL_FILE, NORMALIZATION_FILE, algorithm_classes
+
+EVALUATION_SEED = 100_000
+_EVAL_CALLBACK_SEED_OFFSET = 10_000
+
+
+def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
+    """The block's ``policy_kwargs`` with the activation's name made a class."""
+    kwargs = dict(config["policy_kwargs"])
+    if "activation_fn" in kwargs:
+        names = {
+            "tanh": torch.nn.Tanh,
+            "relu": torch.nn.ReLU,
+            "elu": torch.nn.ELU,
+            "leaky_relu": torch.nn.LeakyReLU,
+        }
+        kwargs["activation_fn"] = names[kwargs["activation_fn"]]
+    return kwargs
+
+
+def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monitor_dir: Path | None):
+    vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
+    return make_vec_env(
+        env_id,
+        n_envs=n_envs,
+        seed=seed,
+        env_kwargs=config["env_kwargs"],
+        monitor_dir=str(monitor_dir) if monitor_dir else None,
+        vec_env_cls=vec_env_cls,
+    )
+
+
+def _normalize(venv, config: dict[str, Any], training: bool):
+    options = config["normalize"]
+    if not options:
+        return venv
+    kwargs = options if isinstance(options, dict) else {}
+    if not training:
+        kwargs = {**kwargs, "norm_reward": False}
+    return VecNormalize(venv, training=training, **kwargs)
+
+
+def learning_curve_figure(evaluations_file: Path, path: Path, title: str) -> Path | None:
+    """Mean evaluation return (± std) against training steps."""
+    if not evaluations_file.is_file():
+        return None
+    data = np.load(evaluations_file)
+    steps, results = data["timesteps"], data["results"]
+    mean, std = results.mean(axis=1), results.std(axis=1)
+    figure = Figure(figsize=(5, 3.2))
+    ax = figure.subplots()
+    ax.plot(steps, mean)
+    ax.fill_between(steps, mean - std, mean + std, alpha=0.3)
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("evaluation return")
+    ax.set_title(title, fontsize=9)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    return path
+
+
+def train(
+    env_id: str,
+    algo: str,
+    config_path: Path | None = None,
+    seed: int = 0,
+    out_root: Path = Path("runs"),
+    n_timesteps: int | None = None,
+    progress: bool = True,
+) -> Path:
+    """Train ``algo`` on ``env_id`` as its configuration says; return the run folder."""
+    check_env_id(env_id)
+    config_path = config_path or default_config_path(env_id)
+    config = load_config(config_path, algo)
+    if n_timesteps is not None:
+        config["n_timesteps"] = n_timesteps
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
+    run_dir.mkdir(parents=True, exist_ok=True)
+    (run_dir / "command.txt").write_text(shlex.join(sys.argv) + "\n")
+    resolved = {"env_id": env_id, "algo": algo, "seed": seed, "config_file": str(config_path)}
+    (run_dir / "config.yml").write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
+
+    n_envs = config["n_envs"]
+    venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
+    eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
+    eval_venv = _normalize(eval_venv, config, False)
+    algorithm = algorithm_classes()[algo]
+    model = algorithm(
+        config["policy"],
+        venv,
+        policy_kwargs=policy_kwargs(config),
+        tensorboard_log=str(run_dir / "tb"),
+        seed=seed,
+        device="cpu",
+        verbose=0,
+        **algorithm_kwargs(config),
+    )
+    eval_dir = run_dir / "eval"
+    if algo == "maskableppo":
+        from sb3_contrib.common.maskable.callbacks import MaskableEvalCallback as EvalCallbackClass
+    else:
+        EvalCallbackClass = EvalCallback
+    callbacks = [
+        EvalCallbackClass(
+            eval_venv,
+            eval_freq=max(config["eval_freq"] // n_envs, 1),
+            n_eval_episodes=config["n_eval_episodes"],
+            best_model_save_path=str(eval_dir),
+            log_path=str(eval_dir),
+            deterministic=True,
+            verbose=0,
+        ),
+        CheckpointCallback(
+            save_freq=max(config["checkpoint_freq"] // n_envs, 1),
+            save_path=str(run_dir / "checkpoints"),
+            name_prefix="model",
+            save_vecnormalize=bool(config["normalize"]),
+        ),
+    ]
+    model.learn(
+        total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
+    )
+    model.save(run_dir / MODEL_FILE)
+    if isinstance(venv, VecNormalize):
+        venv.save(str(run_dir / NORMALIZATION_FILE))
+    learning_curve_figure(
+        eval_dir / "evaluations.npz",
+        eval_dir / "learning_curve.png",
+        f"{algo} on {env_id}, seed {seed}",
+    )
+    venv.close()
+    eval_venv.close()
+    return run_dir
