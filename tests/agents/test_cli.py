@@ -1,0 +1,141 @@
+"""The command line: listing, evaluation outputs, training runs, one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from motiongym.agents.cli import main
+from motiongym.baselines import scripted_policies
+from motiongym.envs import ENV_IDS
+
+SWEEPER = "motiongym/Sweeper-v0"
+
+
+def _error(capsys, argv) -> str:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("motiongym: error: ") and "\n" not in err
+    return err
+
+
+def test_list_names_every_id_and_its_policies(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for env_id in ENV_IDS:
+        assert env_id in out
+        for name in scripted_policies(env_id):
+            assert name in out
+
+
+def test_unknown_id_policy_experiment(capsys, tmp_path):
+    err = _error(capsys, ["evaluate", "motiongym/Nope-v0", "--policy", "x"])
+    assert "Nope-v0" in err and SWEEPER in err
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", "nope", "--out", str(tmp_path)])
+    assert "'nope'" in err
+    for name in scripted_policies(SWEEPER):
+        assert name in err
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", "--env-kwargs", "bogus=1"])
+    assert "bogus" in err
+
+
+def test_config_errors_name_the_key(capsys, tmp_path):
+    bad_key = tmp_path / "bad.yml"
+    bad_key.write_text("ppo:\n  n_timesteps: 10\n  policy: MultiInputPolicy\n  n_step: 4\n")
+    err = _error(capsys, ["train", SWEEPER, "--config", str(bad_key), "--out", str(tmp_path)])
+    assert "'n_step'" in err and "n_steps" in err
+    malformed = tmp_path / "malformed.yml"
+    malformed.write_text("ppo:\n  n_steps: [3\n")
+    assert "malformed YAML" in _error(capsys, ["train", SWEEPER, "--config", str(malformed)])
+    missing = tmp_path / "missing.yml"
+    assert "no configuration file" in _error(capsys, ["train", SWEEPER, "--config", str(missing)])
+    no_block = tmp_path / "sac_only.yml"
+    no_block.write_text("sac:\n  n_timesteps: 10\n  policy: MlpPolicy\n")
+    assert "no block for algorithm 'ppo'" in _error(
+        capsys, ["train", SWEEPER, "--config", str(no_block)]
+    )
+
+
+def test_evaluate_writes_json_and_csv_with_the_env_measures(capsys, tmp_path):
+    argv = [
+        "evaluate",
+        SWEEPER,
+        "--policy",
+        "psa-cwa",
+        "--episodes",
+        "2",
+        "--out",
+        str(tmp_path),
+        "--no-progress",
+        "--env-kwargs",
+        "map=room",
+    ]
+    assert main(argv) == 0
+    data = json.loads(next(tmp_path.glob("*.json")).read_text())
+    assert data["seeds"] == [100_000, 100_001]
+    assert {"coverage", "is_success", "cost", "return", "length"} <= set(data["summary"])
+    assert len(next(tmp_path.glob("*.csv")).read_text().splitlines()) == 3
+
+
+def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
+    argv = ["train", SWEEPER, "--timesteps", "256", "--out", str(tmp_path), "--no-progress"]
+    assert main(argv) == 0
+    (run_dir,) = (tmp_path / "Sweeper-v0").iterdir()
+    for name in ("model.zip", "config.yml", "command.txt", "eval", "tb", "checkpoints"):
+        assert (run_dir / name).exists(), name
+    out = tmp_path / "eval"
+    argv = [
+        "evaluate",
+        SWEEPER,
+        "--policy",
+        str(run_dir),
+        "--episodes",
+        "1",
+        "--out",
+        str(out),
+        "--no-progress",
+        "--env-kwargs",
+        "map=room",
+    ]
+    assert main(argv) == 0
+    assert json.loads(next(out.glob("*.json")).read_text())["summary"]["length"]["mean"] > 0
+
+
+def test_model_for_another_space_is_refused(capsys, tmp_path):
+    from stable_baselines3 import PPO
+
+    model_file = tmp_path / "cartpole.zip"
+    PPO("MlpPolicy", "CartPole-v1", n_steps=32, batch_size=32, device="cpu").save(model_file)
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", str(model_file)])
+    assert "another observation space" in err
+
+
+def test_no_traceback_from_the_installed_command(tmp_path):
+    result = subprocess.run(
+        [
+            str(Path(sys.executable).parent / "motiongym"),
+            "evaluate",
+            "motiongym/Nope-v0",
+            "--policy",
+            "x",
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "argv", [["list"], ["evaluate"], ["compare"], ["train"], ["reproduce"], ["bench"]]
+)
+def test_every_subcommand_has_help(argv, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main([*argv, "--help"])
+    assert exit_info.value.code == 0
+    assert "usage: motiongym" in capsys.readouterr().out
