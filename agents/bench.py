@@ -1,0 +1,290 @@
+"""Throughput of every world, its scripted policies and planners, and PPO on it.
+
+Machines are noisy, so every figure is printed beside a reference measured in
+the same run, as a ratio: Gymnasium's ``CartPole-v1`` and ``Reacher-v5``,
+MiniGrid's ``MiniGrid-Empty-16x16-v0``, and PPO on ``Reacher-v5`` for
+training. The issues' goals are checked here (never by timed tests):
+``GOALS`` for environment throughput, ``PLANNERS`` for planning times.
+
+Memory: each ID runs in a fresh subprocess for ``memory_steps`` random steps;
+the resident set size is read after the first tenth and at the end, and the
+growth between them reported with the peak.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from rich.markdown import Markdown
+
+from motiongym.agents.environments import make_env, resolved_env_kwargs
+from motiongym.agents.report import console
+from motiongym.baselines import make_policy, scripted_policies
+from motiongym.envs import ENV_IDS
+
+REFERENCES = ("CartPole-v1", "Reacher-v5", "MiniGrid-Empty-16x16-v0")
+# Environment throughput goals: ID -> (reference, least ratio to it).
+GOALS: dict[str, tuple[str, float]] = {
+    "motiongym/Sweeper-v0": ("CartPole-v1", 0.3),
+}
+# Vectorised-environment goals: ID -> (least steps/s, least ratio to SyncVectorEnv).
+VECTOR_GOALS: dict[str, tuple[float, float]] = {
+    "motiongym/Sweeper-v0": (1_000_000.0, 100.0),
+}
+# Planners: label -> ("module:function" taking no argument and planning once, goal in s).
+PLANNERS: dict[str, tuple[str, float | None]] = {}
+
+
+def machine() -> str:
+    """The processor and core count, for the published table."""
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{model}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def steps_per_second(env: gym.Env, seconds: float, seed: int = 0) -> float:
+    """Random-action steps per second of ``env`` (resets included)."""
+    env.reset(seed=seed)
+    env.action_space.seed(seed)
+    actions = [env.action_space.sample() for _ in range(1024)]
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        for action in actions:
+            _, _, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                env.reset()
+        steps += len(actions)
+    return steps / (time.perf_counter() - start)
+
+
+def vector_steps_per_second(env: gym.vector.VectorEnv, seconds: float) -> float:
+    """Steps per second, summed over sub-environments, of a vector env."""
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    actions = [env.action_space.sample() for _ in range(16)]
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        for action in actions:
+            env.step(action)
+        steps += len(actions) * env.num_envs
+    return steps / (time.perf_counter() - start)
+
+
+def policy_ms_per_step(env_id: str, name: str, max_steps: int) -> float:
+    """Milliseconds per ``predict`` call of a scripted policy over one episode."""
+    env = make_env(env_id)
+    policy = make_policy(
+        env_id, name, env.observation_space, env.action_space, resolved_env_kwargs(env_id, None)
+    )
+    observation, _ = env.reset(seed=0)
+    elapsed, steps, start_flag = 0.0, 0, True
+    while steps < max_steps:
+        start = time.perf_counter()
+        action, _ = policy.predict(observation, episode_start=np.array([start_flag]))
+        elapsed += time.perf_counter() - start
+        start_flag = False
+        observation, _, terminated, truncated, _ = env.step(action)
+        steps += 1
+        if terminated or truncated:
+            break
+    return 1000 * elapsed / steps
+
+
+def ppo_steps_per_second(env_id: str, timesteps: int) -> float:
+    """PPO (SB3 defaults, one environment) training steps per second."""
+    from stable_baselines3 import PPO
+
+    env = gym.make(env_id)
+    policy = (
+        "MultiInputPolicy" if isinstance(env.observation_space, gym.spaces.Dict) else "MlpPolicy"
+    )
+    model = PPO(policy, env, n_steps=512, batch_size=64, n_epochs=4, device="cpu", seed=0)
+    start = time.perf_counter()
+    model.learn(total_timesteps=timesteps)
+    return timesteps / (time.perf_counter() - start)
+
+
+def planner_seconds(target: str, repeats: int) -> float:
+    """Median wall time of a planner call ``module:function``."""
+    module, function = target.split(":")
+    plan: Callable[[], Any] = getattr(importlib.import_module(module), function)
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        plan()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times))
+
+
+def memory_probe(env_id: str, steps: int) -> dict[str, float]:
+    """Run in a fresh process: RSS (MiB) after a tenth of the steps, at the end, and peak."""
+    import resource
+
+    def rss_mib() -> float:
+        pages = int(Path("/proc/self/statm").read_text().split()[1])
+        return pages * resource.getpagesize() / 2**20
+
+    env = gym.make(env_id)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    actions = [env.action_space.sample() for _ in range(1024)]
+    early = rss_mib()
+    for step in range(steps):
+        _, _, terminated, truncated, _ = env.step(actions[step % len(actions)])
+        if terminated or truncated:
+            env.reset()
+        if step == steps // 10:
+            early = rss_mib()
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return {"rss_early_mib": early, "rss_end_mib": rss_mib(), "peak_mib": peak}
+
+
+def memory_growth(env_id: str, steps: int) -> dict[str, float]:
+    code = (
+        "import json, motiongym; from motiongym.agents.bench import memory_probe; "
+        f"print(json.dumps(memory_probe({env_id!r}, {steps})))"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
+    probe = json.loads(result.stdout.strip().splitlines()[-1])
+    probe["growth_mib"] = probe["rss_end_mib"] - probe["rss_early_mib"]
+    probe["steps"] = steps
+    return probe
+
+
+def _verdict(value: float, goal: float | None, higher_is_better: bool = True) -> str:
+    if goal is None:
+        return ""
+    met = value >= goal if higher_is_better else value <= goal
+    return "met" if met else "MISSED"
+
+
+def bench(out_dir: Path, quick: bool = False, env_ids: list[str] | None = None) -> dict:
+    """Measure everything; print the tables; write ``bench.json`` and ``bench.md``."""
+    seconds = 0.5 if quick else 3.0
+    env_ids = list(env_ids or ENV_IDS)
+    results: dict[str, Any] = {"machine": machine(), "quick": quick, "references": {}}
+    for reference in REFERENCES:
+        results["references"][reference] = steps_per_second(gym.make(reference), seconds)
+    ppo_steps = 1024 if quick else 8192
+    results["references"]["PPO Reacher-v5"] = ppo_steps_per_second("Reacher-v5", ppo_steps)
+
+    rows = []
+    for env_id in env_ids:
+        row: dict[str, Any] = {
+            "id": env_id,
+            "steps_per_s": steps_per_second(make_env(env_id), seconds),
+        }
+        for reference in REFERENCES:
+            row[f"x {reference}"] = row["steps_per_s"] / results["references"][reference]
+        reference, goal = GOALS.get(env_id, (None, None))
+        if reference:
+            row["goal"] = f">= {goal}x {reference}"
+            row["goal_met"] = _verdict(row[f"x {reference}"], goal)
+        row["policy_ms_per_step"] = {
+            name: policy_ms_per_step(env_id, name, 200 if quick else 2000)
+            for name in scripted_policies(env_id)
+        }
+        row["ppo_steps_per_s"] = ppo_steps_per_second(env_id, ppo_steps)
+        row["x PPO Reacher-v5"] = row["ppo_steps_per_s"] / results["references"]["PPO Reacher-v5"]
+        if gym.spec(env_id).vector_entry_point:
+            row["vector"] = _vector_row(env_id, seconds, quick)
+        row["memory"] = memory_growth(env_id, 20_000 if quick else 1_000_000)
+        rows.append(row)
+    results["environments"] = rows
+    results["planners"] = {
+        label: {
+            "seconds": (s := planner_seconds(target, 3 if quick else 10)),
+            "goal_s": goal,
+            "goal_met": _verdict(s, goal, higher_is_better=False),
+        }
+        for label, (target, goal) in PLANNERS.items()
+    }
+    console.print(Markdown(markdown(results)))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "bench.json").write_text(json.dumps(results, indent=2))
+    (out_dir / "bench.md").write_text(markdown(results))
+    console.print(f"wrote {out_dir / 'bench.json'} and {out_dir / 'bench.md'}")
+    return results
+
+
+def _vector_row(env_id: str, seconds: float, quick: bool) -> dict[str, Any]:
+    num_envs = 1024 if quick else 4096
+    native = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point")
+    sync = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="sync")
+    row = {
+        "num_envs": num_envs,
+        "native_steps_per_s": vector_steps_per_second(native, seconds),
+        "sync_steps_per_s": vector_steps_per_second(sync, seconds),
+    }
+    row["x sync"] = row["native_steps_per_s"] / row["sync_steps_per_s"]
+    least_rate, least_ratio = VECTOR_GOALS.get(env_id, (None, None))
+    if least_rate:
+        row["goal"] = f">= {least_rate:.0f} steps/s and >= {least_ratio}x sync"
+        met = row["native_steps_per_s"] >= least_rate and row["x sync"] >= least_ratio
+        row["goal_met"] = "met" if met else "MISSED"
+    return row
+
+
+def markdown(results: dict[str, Any]) -> str:
+    """The environment table as Markdown (for the README)."""
+    refs = results["references"]
+    lines = [
+        f"Measured on: {results['machine']}. References in the same run: "
+        + ", ".join(f"{name} {rate:,.0f} steps/s" for name, rate in refs.items())
+        + ".",
+        "",
+        "| ID | steps/s | x CartPole | x Reacher | x MiniGrid | PPO steps/s (x Reacher PPO) "
+        "| goal | peak MiB / growth over run |",
+        "|---|---:|---:|---:|---:|---:|---|---|",
+    ]
+    for row in results["environments"]:
+        memory = row["memory"]
+        goal = f"{row.get('goal', '')} {row.get('goal_met', '')}".strip()
+        lines.append(
+            f"| {row['id']} | {row['steps_per_s']:,.0f} | {row['x CartPole-v1']:.2f} "
+            f"| {row['x Reacher-v5']:.2f} | {row['x MiniGrid-Empty-16x16-v0']:.2f} "
+            f"| {row['ppo_steps_per_s']:,.0f} ({row['x PPO Reacher-v5']:.2f}) | {goal} "
+            f"| {memory['peak_mib']:.0f} / {memory['growth_mib']:+.1f} over "
+            f"{memory['steps']:,} steps |"
+        )
+    for row in results["environments"]:
+        if "vector" in row:
+            vector = row["vector"]
+            lines.append("")
+            lines.append(
+                f"Vectorised {row['id']} ({vector['num_envs']} envs): "
+                f"{vector['native_steps_per_s']:,.0f} steps/s, "
+                f"{vector['x sync']:.0f}x SyncVectorEnv {vector.get('goal_met', '')}"
+            )
+    if results["planners"]:
+        lines += ["", "| planner | seconds | goal |", "|---|---:|---|"]
+        for label, planner in results["planners"].items():
+            goal = f"<= {planner['goal_s']} s {planner['goal_met']}" if planner["goal_s"] else ""
+            lines.append(f"| {label} | {planner['seconds']:.4f} | {goal} |")
+    policy_rows = [
+        f"| {row['id']} | {name} | {ms:.3f} |"
+        for row in results["environments"]
+        for name, ms in row["policy_ms_per_step"].items()
+    ]
+    if policy_rows:
+        lines += ["", "| ID | scripted policy | ms per step |", "|---|---|---:|", *policy_rows]
+    return "\n".join(lines) + "\n"
