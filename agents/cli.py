@@ -1,4 +1,4 @@
-"""The ``motiongym`` command: list, evaluate, compare, train, reproduce, bench.
+"""The ``motiongym`` command: list, evaluate, compare, train, ship, reproduce, bench.
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
 malformed YAML file, a model built for another space) ends in one line on
@@ -108,6 +108,13 @@ def cmd_train(args: argparse.Namespace) -> None:
     console.print(f"run folder: {run_dir}")
 
 
+def cmd_ship(args: argparse.Namespace) -> None:
+    from motiongym.agents.pretrained import ship
+    from motiongym.agents.report import console
+
+    console.print(f"shipped to {ship(args.run_dir, n_episodes=args.episodes)}")
+
+
 def cmd_reproduce(args: argparse.Namespace) -> None:
     from motiongym.agents.reproduce import reproduce
 
@@ -186,6 +193,11 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument("--out", type=Path, default=Path("runs"), help="where run folders go")
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     train.set_defaults(handler=cmd_train)
+
+    ship = commands.add_parser("ship", help="copy a training run into agents/pretrained/")
+    ship.add_argument("run_dir", type=Path, help="a run folder written by motiongym train")
+    ship.add_argument("--episodes", type=int, default=20, help="held-out evaluation episodes")
+    ship.set_defaults(handler=cmd_ship)
 
     reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")
     reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))

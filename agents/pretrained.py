@@ -58,3 +58,42 @@ def pretrained_models(env_id: str) -> dict[str, Path]:
     return {
         folder.name: folder for folder in sorted(root.iterdir()) if (folder / "model.zip").is_file()
     }
+
+
+SHIPPED_FILES = ("model.zip", "vecnormalize.pkl", "config.yml", "command.txt")
+
+
+def ship(
+    run_dir: Path, n_episodes: int = 20, seed: int = 100_000, root: Path | None = None
+) -> Path:
+    """Copy a training run into ``pretrained/`` with its metrics and manifest.
+
+    The run's ``config.yml`` names the ID and algorithm; the model is
+    evaluated on ``n_episodes`` held-out seeds from ``seed`` and the summary
+    saved as ``metrics.json``; the manifest is written last.
+    """
+    import shutil
+
+    import yaml
+
+    from motiongym.agents.environments import make_env
+    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.predictors import load_model
+
+    config_file = run_dir / "config.yml"
+    if not config_file.is_file():
+        raise UsageError(f"{run_dir} is not a training run folder (no config.yml)")
+    config = yaml.safe_load(config_file.read_text())
+    env_id, algo = config["env_id"], config["algo"]
+    folder = (root or pretrained_root()) / short_name(env_id) / algo
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in SHIPPED_FILES:
+        if (run_dir / name).is_file():
+            shutil.copy2(run_dir / name, folder / name)
+    env = make_env(env_id, config.get("env_kwargs"))
+    model = load_model(folder, env, env_id)
+    evaluation = evaluate(env, model, range(seed, seed + n_episodes), env_id, algo)
+    metrics = {"env_id": env_id, "algo": algo, "run": run_dir.name, **evaluation.to_json()}
+    (folder / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    write_manifest(folder)
+    return folder

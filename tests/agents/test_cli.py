@@ -132,7 +132,7 @@ def test_no_traceback_from_the_installed_command(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "argv", [["list"], ["evaluate"], ["compare"], ["train"], ["reproduce"], ["bench"]]
+    "argv", [["list"], ["evaluate"], ["compare"], ["train"], ["reproduce"], ["ship"], ["bench"]]
 )
 def test_every_subcommand_has_help(argv, capsys):
     with pytest.raises(SystemExit) as exit_info:
