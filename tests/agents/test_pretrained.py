@@ -9,8 +9,8 @@ import pytest
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import evaluate
-from motiongym.agents.pretrained import pretrained_models, ship, verify_manifest
 from motiongym.agents.predictors import load_predictor
+from motiongym.agents.pretrained import pretrained_models, ship, verify_manifest
 from motiongym.agents.train import train
 from motiongym.envs import ENV_IDS
 
