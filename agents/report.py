@@ -47,6 +47,26 @@ def comparison_table(evaluations: list[Evaluation]) -> Table:
     return table
 
 
+def comparison_markdown(evaluations: list[Evaluation]) -> str:
+    """The comparison table as Markdown: mean ± 95 % interval half-width."""
+    names = [evaluation.policy for evaluation in evaluations]
+    summaries = [evaluation.summary() for evaluation in evaluations]
+    n = len(evaluations[0].episodes)
+    lines = [
+        f"{evaluations[0].env_id}, {n} episodes per policy (mean ± 95% interval)",
+        "",
+        "| measure | " + " | ".join(names) + " |",
+        "|---|" + "---:|" * len(names),
+    ]
+    for key in evaluations[0].measures:
+        cells = [
+            f"{_number(s[key]['mean'])} ± {_number(s[key]['ci95'])}" if key in s else "-"
+            for s in summaries
+        ]
+        lines.append(f"| {key} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def comparison_figure(evaluations: list[Evaluation], path: Path) -> Path:
     """A bar per policy for each measure, with 95 % interval error bars."""
     measures = evaluations[0].measures
@@ -78,7 +98,9 @@ def write_comparison(evaluations: list[Evaluation], out_dir: Path, stem: str) ->
         written += evaluation.write(out_dir, f"{stem}_{_file_safe(evaluation.policy)}")
     combined = out_dir / f"{stem}_comparison.json"
     combined.write_text(json.dumps([e.to_json() for e in evaluations], indent=2))
-    written.append(combined)
+    table = out_dir / f"{stem}_comparison.md"
+    table.write_text(comparison_markdown(evaluations))
+    written += [combined, table]
     written.append(comparison_figure(evaluations, out_dir / f"{stem}_comparison.png"))
     return written
 
