@@ -29,41 +29,45 @@ def summary_table(evaluation: Evaluation) -> Table:
     return table
 
 
-def comparison_table(evaluations: list[Evaluation]) -> Table:
-    """One row per measure, one column per policy: mean ± 95 % interval half-width."""
-    env_id = evaluations[0].env_id
+def comparison_rows(evaluations: list[Evaluation]) -> list[list[str]]:
+    """One row per measure: its name, then "mean ± 95 % half-width" per policy."""
+    summaries = [evaluation.summary() for evaluation in evaluations]
+    return [
+        [key]
+        + [
+            f"{_number(s[key]['mean'])} ± {_number(s[key]['ci95'])}" if key in s else "-"
+            for s in summaries
+        ]
+        for key in evaluations[0].measures
+    ]
+
+
+def _comparison_title(evaluations: list[Evaluation]) -> str:
     n = len(evaluations[0].episodes)
-    table = Table(title=f"{env_id}: mean ± 95% interval over {n} episodes")
+    return f"{evaluations[0].env_id}: mean ± 95% interval over {n} episodes per policy"
+
+
+def comparison_table(evaluations: list[Evaluation]) -> Table:
+    """One row per measure, one column per policy (rich, for the terminal)."""
+    table = Table(title=_comparison_title(evaluations))
     table.add_column("measure")
     for evaluation in evaluations:
         table.add_column(evaluation.policy, justify="right")
-    summaries = [evaluation.summary() for evaluation in evaluations]
-    for key in evaluations[0].measures:
-        cells = []
-        for summary in summaries:
-            stats = summary.get(key)
-            cells.append(f"{_number(stats['mean'])} ± {_number(stats['ci95'])}" if stats else "-")
-        table.add_row(key, *cells)
+    for row in comparison_rows(evaluations):
+        table.add_row(*row)
     return table
 
 
 def comparison_markdown(evaluations: list[Evaluation]) -> str:
-    """The comparison table as Markdown: mean ± 95 % interval half-width."""
+    """The same table as Markdown (for generated reports)."""
     names = [evaluation.policy for evaluation in evaluations]
-    summaries = [evaluation.summary() for evaluation in evaluations]
-    n = len(evaluations[0].episodes)
     lines = [
-        f"{evaluations[0].env_id}, {n} episodes per policy (mean ± 95% interval)",
+        _comparison_title(evaluations),
         "",
         "| measure | " + " | ".join(names) + " |",
         "|---|" + "---:|" * len(names),
     ]
-    for key in evaluations[0].measures:
-        cells = [
-            f"{_number(s[key]['mean'])} ± {_number(s[key]['ci95'])}" if key in s else "-"
-            for s in summaries
-        ]
-        lines.append(f"| {key} | " + " | ".join(cells) + " |")
+    lines += ["| " + " | ".join(row) + " |" for row in comparison_rows(evaluations)]
     return "\n".join(lines) + "\n"
 
 
