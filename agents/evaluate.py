@@ -21,6 +21,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from scipy import stats
 from tqdm.auto import tqdm
 
 from motiongym.agents.errors import UsageError
@@ -82,11 +83,16 @@ class Evaluation:
         return [key for key in self.episodes[0] if key != "seed"] if self.episodes else []
 
     def summary(self) -> dict[str, dict[str, float]]:
-        """Mean, standard deviation, 95 % interval half-width, min and max per measure."""
+        """Mean, standard deviation, 95 % interval half-width, min and max per measure.
+
+        The interval is Student's t interval of the mean over episodes.
+        """
         table = {}
+        n = len(self.episodes)
+        t_quantile = float(stats.t.ppf(0.975, n - 1)) if n > 1 else 0.0
         for key in self.measures:
             values = np.array([episode[key] for episode in self.episodes])
-            half_width = 1.96 * values.std(ddof=1) / np.sqrt(len(values)) if len(values) > 1 else 0
+            half_width = t_quantile * values.std(ddof=1) / np.sqrt(n) if n > 1 else 0.0
             table[key] = {
                 "mean": float(values.mean()),
                 "std": float(values.std()),
