@@ -16,6 +16,7 @@ import yaml
 
 from motiongym.agents.environments import check_env_id, make_env, short_name
 from motiongym.agents.errors import UsageError
+from motiongym.agents.evaluate import EVALUATION_SEED
 from motiongym.baselines.registry import UnknownPolicyError
 from motiongym.envs import ENV_IDS
 
@@ -137,8 +138,8 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--seed",
         type=int,
-        default=100_000,
-        help="seed of the first episode; episode i uses seed+i (default 100000)",
+        default=EVALUATION_SEED,
+        help=f"seed of the first episode; episode i uses seed+i (default {EVALUATION_SEED})",
     )
     parser.add_argument(
         "--env-kwargs",

@@ -18,7 +18,8 @@ policy         SB3 policy name (``MlpPolicy``, ``MultiInputPolicy``) required
 policy_kwargs  network and activation (mapping)                      {}
 env_kwargs     keywords for ``gym.make``                             {}
 normalize      VecNormalize: false, true, or a mapping of its kwargs false
-vec_env        ``dummy`` or ``subproc``                              dummy
+vec_env        ``dummy``, ``subproc`` or ``native`` (the ID's own     dummy
+               NumPy-batched vector env, see agents/vector.py)
 eval_freq      steps between evaluations (over all envs)             10000
 n_eval_episodes episodes per evaluation                              5
 checkpoint_freq steps between checkpoints (over all envs)            50000
@@ -51,6 +52,7 @@ RUN_SETTINGS: dict[str, Any] = {
     "checkpoint_freq": 50_000,
 }
 REQUIRED = ("n_timesteps", "policy")
+VEC_ENVS = ("dummy", "subproc", "native")
 ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
 # Constructor arguments the run itself provides.
 _PROVIDED = {
@@ -115,8 +117,8 @@ def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
         raise UsageError(
             f"{where}: activation_fn {activation!r} unknown; valid: {', '.join(ACTIVATIONS)}"
         )
-    if config["vec_env"] not in ("dummy", "subproc"):
-        raise UsageError(f"{where}: vec_env must be 'dummy' or 'subproc'")
+    if config["vec_env"] not in VEC_ENVS:
+        raise UsageError(f"{where}: vec_env must be one of {', '.join(VEC_ENVS)}")
     return config
 
 

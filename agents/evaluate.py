@@ -26,6 +26,9 @@ from tqdm.auto import tqdm
 
 from motiongym.agents.errors import UsageError
 
+# First seed of evaluations: far from the small seeds training runs use.
+EVALUATION_SEED = 100_000
+
 AGGREGATIONS: dict[str, Callable[[np.ndarray], float]] = {
     "last": lambda values: float(values[-1]),
     "sum": lambda values: float(np.sum(values)),

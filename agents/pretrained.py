@@ -77,7 +77,7 @@ def ship(
     import yaml
 
     from motiongym.agents.environments import make_env
-    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
     from motiongym.agents.predictors import load_model
 
     config_file = run_dir / "config.yml"
@@ -92,6 +92,7 @@ def ship(
             shutil.copy2(run_dir / name, folder / name)
     env = make_env(env_id, config.get("env_kwargs"))
     model = load_model(folder, env, env_id)
+    seed = EVALUATION_SEED if seed is None else seed
     evaluation = evaluate(env, model, range(seed, seed + n_episodes), env_id, algo)
     metrics = {"env_id": env_id, "algo": algo, "run": run_dir.name, **evaluation.to_json()}
     (folder / "metrics.json").write_text(json.dumps(metrics, indent=2))

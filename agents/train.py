@@ -10,8 +10,8 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 * ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs).
 
 Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
-callback's environment ``seed + 10_000``. Evaluation suites use seeds from
-``EVALUATION_SEED`` up, far from both.
+callback's environment ``seed + 10_000``. Evaluations use seeds from
+``motiongym.agents.evaluate.EVALUATION_SEED`` up, far from both.
 """
 
 from __future__ import annotations
@@ -22,19 +22,26 @@ import time
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import torch
 import yaml
 from matplotlib.figure import Figure
 from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 from stable_baselines3.common.env_util import make_vec_env
-from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecNormalize
+from stable_baselines3.common.vec_env import (
+    DummyVecEnv,
+    SubprocVecEnv,
+    VecMonitor,
+    VecNormalize,
+)
 
 from motiongym.agents.config import algorithm_kwargs, default_config_path, load_config
 from motiongym.agents.environments import check_env_id, short_name
+from motiongym.agents.errors import UsageError
 from motiongym.agents.predictors import MODEL_FILE, NORMALIZATION_FILE, algorithm_classes
+from motiongym.agents.vector import VectorEnvAdapter
 
-EVALUATION_SEED = 100_000
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
 
@@ -53,6 +60,18 @@ def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
 
 
 def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monitor_dir: Path | None):
+    """The training environments as SB3 wants them, per the block's ``vec_env``."""
+    if config["vec_env"] == "native":
+        if not gym.spec(env_id).vector_entry_point:
+            raise UsageError(f"{env_id} has no native vector environment; use dummy or subproc")
+        native = gym.make_vec(
+            env_id, num_envs=n_envs, vectorization_mode="vector_entry_point", **config["env_kwargs"]
+        )
+        venv = VectorEnvAdapter(native)
+        venv.seed(seed)
+        if monitor_dir:
+            monitor_dir.mkdir(parents=True, exist_ok=True)
+        return VecMonitor(venv, str(monitor_dir / "native") if monitor_dir else None)
     vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
     return make_vec_env(
         env_id,
