@@ -1,4 +1,4 @@
-"""The sweeper world: a cleaning robot covering an unknown closed area."""
+"""The sweeper world: a cleaning robot covering an unknown closed area (paper 003)."""
 
 from __future__ import annotations
 
@@ -7,5 +7,6 @@ REGISTRATIONS: tuple[dict, ...] = (
         "id": "motiongym/Sweeper-v0",
         "entry_point": "motiongym.envs.sweeper.env:SweeperEnv",
         "max_episode_steps": 20_000,
+        "kwargs": {"map_name": "room", "robot_width": 3},
     },
 )

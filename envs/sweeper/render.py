@@ -1,0 +1,56 @@
+"""RGB image of the sweeper world: map, swept cells, path, robot (paper Fig. 7-14 style)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from motiongym.envs.sweeper.world import DC, DR
+
+if TYPE_CHECKING:
+    from motiongym.envs.sweeper.env import SweeperEnv
+
+OBSTACLE = np.array([20, 20, 20], np.uint8)
+UNREACHABLE = np.array([150, 150, 170], np.uint8)
+FREE = np.array([255, 255, 255], np.uint8)
+SWEPT = np.array([190, 190, 190], np.uint8)  # the paper's grey
+OVERSWEPT = np.array([130, 130, 130], np.uint8)  # swept more than once
+PATH = np.array([30, 90, 220], np.uint8)
+ROBOT = np.array([220, 40, 40], np.uint8)
+BELIEVED = np.array([250, 160, 0], np.uint8)
+
+
+def draw(env: SweeperEnv, px: int = 8) -> np.ndarray:
+    """``(H * px, W * px, 3)`` uint8 image of ``env``'s current state."""
+    sc = env.scenario
+    h, wd = sc.obstacle.shape
+    img = np.empty((h, wd, 3), np.uint8)
+    img[:] = FREE
+    img[~sc.reachable & ~sc.obstacle] = UNREACHABLE
+    img[sc.obstacle] = OBSTACLE
+    img[env.sweeps == 1] = SWEPT
+    img[env.sweeps > 1] = OVERSWEPT
+    img = img.repeat(px, axis=0).repeat(px, axis=1)
+    w = env.w
+    centre = (w * px) // 2
+    dot = max(1, px // 4)
+    for r, c in env.path:  # path of the footprint centre
+        y, x = r * px + centre, c * px + centre
+        img[y - dot : y + dot, x - dot : x + dot] = PATH
+    if env.noisy:
+        _square(img, env.br * px, env.bc * px, w * px, BELIEVED)
+    _square(img, env.r * px, env.c * px, w * px, ROBOT)
+    y, x = env.r * px + centre, env.c * px + centre
+    for k in range(centre):  # heading marker
+        yy, xx = y + int(DR[env.h]) * k, x + int(DC[env.h]) * k
+        img[yy - dot : yy + dot, xx - dot : xx + dot] = ROBOT
+    return img
+
+
+def _square(img: np.ndarray, y: int, x: int, size: int, colour: np.ndarray) -> None:
+    t = max(1, size // 12)
+    img[y : y + t, x : x + size] = colour
+    img[y + size - t : y + size, x : x + size] = colour
+    img[y : y + size, x : x + t] = colour
+    img[y : y + size, x + size - t : x + size] = colour
