@@ -1,5 +1,24 @@
-"""The harvest arm world (not yet built)."""
+"""The harvest arm world: a redundant fruit-harvesting arm among branches and immature fruit.
+
+Two IDs cover the paper's six arms: ``motiongym/HarvestArm-v0`` (spatial,
+``dof`` 5, 6 or 7, default 7; 10 obstacles, 3 bars) and
+``motiongym/HarvestArmPlanar-v0`` (planar, ``dof`` 3, 4 or 5, default 5; 8
+obstacles). See :class:`motiongym.envs.harvest_arm.env.HarvestArmEnv`.
+"""
 
 from __future__ import annotations
 
-REGISTRATIONS: tuple[dict, ...] = ()
+REGISTRATIONS: tuple[dict, ...] = (
+    {
+        "id": "motiongym/HarvestArm-v0",
+        "entry_point": "motiongym.envs.harvest_arm.env:HarvestArmEnv",
+        "max_episode_steps": 300,
+        "kwargs": {"dof": 7, "planar": False},
+    },
+    {
+        "id": "motiongym/HarvestArmPlanar-v0",
+        "entry_point": "motiongym.envs.harvest_arm.env:HarvestArmEnv",
+        "max_episode_steps": 300,
+        "kwargs": {"dof": 5, "planar": True},
+    },
+)

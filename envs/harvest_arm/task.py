@@ -1,0 +1,173 @@
+"""Scenes of the harvest-arm world: the fruit and the obstacles, sampled per reset.
+
+The paper generates "8 random obstacles" in the plane and "10 random
+obstacles, 3 in 10 bars" in space, and does not say where. Our scene
+distribution (fixed for the ``-v0`` IDs):
+
+* Planar (x-y, base at the origin): obstacles are immature fruit, circles of
+  radius U(0.015, 0.03) m, centres uniform in the canopy box
+  x in [0.05, 0.85], y in [-0.6, 0.2]; the fruit in x in [0.2, 0.8],
+  y in [-0.6, -0.1]. No bars in the plane (the paper's bars are a 3-D case).
+* Spatial (z up, shoulder at z = 0.3302): spheres of radius U(0.015, 0.03) m
+  and exactly ``n_bars`` branches (capsules of radius 0.01 m, length
+  U(0.2, 0.5) m, direction uniform on the sphere, centre in the box), in the
+  canopy box x in [0.15, 0.85], y in [-0.4, 0.4], z in [0.05, 0.75]; the
+  fruit in x in [0.4, 0.8], y in [-0.35, 0.35], z in [0.1, 0.45].
+* Rejection: an obstacle must keep 0.05 m clear of the arm's start pose and
+  0.06 m of surface clearance from the fruit sphere (radius
+  ``FRUIT_RADIUS``), so that the gripper can reach the fruit's centre. The
+  fruit must be at least 0.25 m from the start gripper and reachable: a
+  damped least-squares IK within the joint limits must bring the gripper
+  within 2 mm of it.
+
+Everything is drawn from the ``rng`` passed in (the env's ``np_random``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motiongym.envs.geometry import closest_points_between_segments
+from motiongym.envs.harvest_arm.model import ArmKinematics
+
+FRUIT_RADIUS = 0.035  # m
+SPHERE_RADIUS = (0.015, 0.03)  # m, immature fruit
+BAR_RADIUS = 0.01  # m, branches
+BAR_LENGTH = (0.2, 0.5)  # m
+START_CLEARANCE = 0.05  # m, obstacles vs the arm's start pose
+FRUIT_CLEARANCE = 0.06  # m, obstacle surface vs fruit surface
+MIN_TRAVEL = 0.25  # m, fruit vs start gripper
+
+PLANAR_BOX = np.array([[0.05, -0.6], [0.85, 0.2]])  # (2, 2): low, high (m)
+PLANAR_FRUIT_BOX = np.array([[0.2, -0.6], [0.8, -0.1]])
+SPATIAL_BOX = np.array([[0.15, -0.4, 0.05], [0.85, 0.4, 0.75]])  # (2, 3)
+SPATIAL_FRUIT_BOX = np.array([[0.4, -0.35, 0.1], [0.8, 0.35, 0.45]])
+
+
+@dataclass
+class Scene:
+    """One scenario. Spheres have ``a == b``; bars are the segments ``ab``."""
+
+    fruit: np.ndarray  # (dim,) m
+    a: np.ndarray  # (K, dim) m
+    b: np.ndarray  # (K, dim) m
+    radius: np.ndarray  # (K,) m
+    is_bar: np.ndarray  # (K,) bool
+
+    def __len__(self) -> int:
+        return len(self.radius)
+
+
+def scene_from_obstacles(fruit: np.ndarray, obstacles: list[dict], dim: int) -> Scene:
+    """A scene from explicit obstacles ``{"center", "radius"}`` or ``{"a", "b", "radius"}``."""
+    fruit = np.asarray(fruit, float).reshape(-1)
+    if fruit.shape != (dim,):
+        raise ValueError(f"fruit must have {dim} coordinates, got shape {fruit.shape}")
+    a, b, r, bar = [], [], [], []
+    for i, ob in enumerate(obstacles):
+        keys = set(ob)
+        if keys == {"center", "radius"}:
+            c = np.asarray(ob["center"], float)
+            a.append(c)
+            b.append(c)
+            bar.append(False)
+        elif keys == {"a", "b", "radius"}:
+            a.append(np.asarray(ob["a"], float))
+            b.append(np.asarray(ob["b"], float))
+            bar.append(True)
+        else:
+            raise ValueError(
+                f"obstacle {i} has keys {sorted(keys)}; expected "
+                "{'center', 'radius'} (sphere) or {'a', 'b', 'radius'} (bar)"
+            )
+        if a[-1].shape != (dim,) or b[-1].shape != (dim,):
+            raise ValueError(f"obstacle {i} points must have {dim} coordinates")
+        r.append(float(ob["radius"]))
+    return Scene(
+        fruit,
+        np.array(a, float).reshape(-1, dim),
+        np.array(b, float).reshape(-1, dim),
+        np.array(r, float),
+        np.array(bar, bool),
+    )
+
+
+def solve_ik(
+    kin: ArmKinematics, target: np.ndarray, q0: np.ndarray, iters: int = 150
+) -> tuple[np.ndarray, float]:
+    """Damped least-squares IK of the gripper position within joint limits.
+
+    Returns:
+        ``(q, error)``: the joint angles (n,) and the final gripper error (m).
+    """
+    q = np.array(q0, float)
+    limits = kin.spec.limits
+    err = np.inf
+    for _ in range(iters):
+        points, jac = kin.jacobians(q)
+        e = target - points[-1]
+        err = float(np.linalg.norm(e))
+        if err < 1e-4:
+            break
+        j = jac[-1]  # (dim, n)
+        step = j.T @ np.linalg.solve(j @ j.T + 1e-3 * np.eye(len(e)), e)
+        q = np.clip(q + np.clip(step, -0.3, 0.3), -limits, limits)
+    return q, err
+
+
+def clearance_to_arm(points: np.ndarray, link_radius: float, scene: Scene) -> np.ndarray:
+    """Surface clearance of each obstacle to the arm given by its points: (K,)."""
+    p0, p1 = points[:-1, None, :], points[1:, None, :]  # (L, 1, dim)
+    dist, _, _ = closest_points_between_segments(p0, p1, scene.a[None], scene.b[None])  # (L, K)
+    return dist.min(axis=0) - link_radius - scene.radius
+
+
+def sample_scene(
+    rng: np.random.Generator,
+    kin: ArmKinematics,
+    n_obstacles: int,
+    n_bars: int,
+    link_radius: float,
+) -> Scene:
+    """Sample a scene as documented in the module docstring."""
+    planar = kin.spec.planar
+    box = PLANAR_BOX if planar else SPATIAL_BOX
+    fruit_box = PLANAR_FRUIT_BOX if planar else SPATIAL_FRUIT_BOX
+    dim = kin.dim
+    home = np.array(kin.spec.home)
+    start = kin.forward(home)  # (P, dim)
+    for _ in range(200):
+        fruit = rng.uniform(fruit_box[0], fruit_box[1])
+        if np.linalg.norm(fruit - start[-1]) < MIN_TRAVEL:
+            continue
+        if solve_ik(kin, fruit, home)[1] < 2e-3:
+            break
+    else:  # pragma: no cover - the fruit box lies well inside the reach
+        raise RuntimeError("no reachable fruit found in 200 draws")
+    a = np.zeros((n_obstacles, dim))
+    b = np.zeros((n_obstacles, dim))
+    radius = np.zeros(n_obstacles)
+    is_bar = np.arange(n_obstacles) >= n_obstacles - n_bars
+    for k in range(n_obstacles):
+        for _ in range(1000):
+            centre = rng.uniform(box[0], box[1])
+            if is_bar[k]:
+                direction = rng.normal(size=dim)
+                direction /= np.linalg.norm(direction)
+                half = 0.5 * rng.uniform(*BAR_LENGTH) * direction
+                a[k], b[k], radius[k] = centre - half, centre + half, BAR_RADIUS
+            else:
+                a[k] = b[k] = centre
+                radius[k] = rng.uniform(*SPHERE_RADIUS)
+            one = Scene(fruit, a[k : k + 1], b[k : k + 1], radius[k : k + 1], is_bar[k : k + 1])
+            if clearance_to_arm(start, link_radius, one)[0] < START_CLEARANCE:
+                continue
+            fruit_gap = closest_points_between_segments(fruit, fruit, a[k], b[k])[0]
+            if fruit_gap - radius[k] - FRUIT_RADIUS < FRUIT_CLEARANCE:
+                continue
+            break
+        else:  # pragma: no cover - the box is far larger than the exclusions
+            raise RuntimeError("could not place an obstacle in 1000 draws")
+    return Scene(fruit, a, b, radius, is_bar)
