@@ -1,5 +1,18 @@
-"""Scripted reference policies for the harvest arm world."""
+"""Scripted reference policies for the harvest arm world.
+
+``potential-field``: the paper's three layers (potential-field gripper path,
+joint-point reference velocities, weighted pseudo-inverse with null-space
+term). ``resolved-rate``: the plain pseudo-inverse straight to the fruit.
+"""
 
 from __future__ import annotations
 
-POLICIES: dict[str, dict[str, str]] = {}
+_POLICIES = {
+    "potential-field": "motiongym.baselines.harvest_arm.policy:PotentialFieldPolicy",
+    "resolved-rate": "motiongym.baselines.harvest_arm.policy:ResolvedRatePolicy",
+}
+
+POLICIES: dict[str, dict[str, str]] = {
+    "motiongym/HarvestArm-v0": dict(_POLICIES),
+    "motiongym/HarvestArmPlanar-v0": dict(_POLICIES),
+}

@@ -33,12 +33,13 @@ from motiongym.envs.geometry import closest_points_between_segments
 from motiongym.envs.harvest_arm.model import ArmKinematics
 
 FRUIT_RADIUS = 0.035  # m
-SPHERE_RADIUS = (0.015, 0.03)  # m, immature fruit
-BAR_RADIUS = 0.01  # m, branches
+SPHERE_RADIUS = (0.01, 0.02)  # m, immature fruit
+BAR_RADIUS = 0.008  # m, branches
 BAR_LENGTH = (0.2, 0.5)  # m
 START_CLEARANCE = 0.05  # m, obstacles vs the arm's start pose
 FRUIT_CLEARANCE = 0.06  # m, obstacle surface vs fruit surface
-MIN_TRAVEL = 0.25  # m, fruit vs start gripper
+MIN_TRAVEL = 0.35  # m, fruit vs start gripper
+CLUSTER = 0.3  # m, obstacle centres within +-CLUSTER of the fruit (per axis)
 
 PLANAR_BOX = np.array([[0.05, -0.6], [0.85, 0.2]])  # (2, 2): low, high (m)
 PLANAR_FRUIT_BOX = np.array([[0.2, -0.6], [0.8, -0.1]])
@@ -152,7 +153,9 @@ def sample_scene(
     is_bar = np.arange(n_obstacles) >= n_obstacles - n_bars
     for k in range(n_obstacles):
         for _ in range(1000):
-            centre = rng.uniform(box[0], box[1])
+            centre = rng.uniform(
+                np.maximum(box[0], fruit - CLUSTER), np.minimum(box[1], fruit + CLUSTER)
+            )
             if is_bar[k]:
                 direction = rng.normal(size=dim)
                 direction /= np.linalg.norm(direction)

@@ -1,0 +1,153 @@
+"""Safe gripper path by an artificial potential field (paper eq. 2-7, RK4).
+
+The gripper's reference velocity (eq. 7) is
+
+    X_end_dot = |V_end_ref| v,   v = (v_d + sum_j v_ob_j) / |v_d + sum_j v_ob_j|
+
+with the target term (eq. 4), pointing from the gripper to the fruit at
+distance ``d``,
+
+    |v_d| = 1 + eta_t (1/d - 1/d0) / d^2   if d <= d0,   1 otherwise,
+
+and one obstacle term per obstacle (eq. 5), pointing away from it along the
+shortest distance ``rho``,
+
+    |v_ob| = eta (1/rho - 1/rho0) / rho^2   if rho <= rho0,   0 otherwise.
+
+``eta`` is chosen by eq. 6 so that the term equals ``m`` at ``rho = k rho0``:
+``eta (1/(k rho0) - 1/rho0) / (k rho0)^2 = m``. The parameters are the
+paper's Tables 1-2 (the same in 2-D and 3-D).
+
+The path is the integral of ``x_dot = X_end_dot(x)`` from the gripper's start
+by classical 4th-order Runge-Kutta, until within ``tolerance`` of the fruit.
+
+Choices where the paper is silent: ``rho`` is the *surface clearance*
+(centre distance minus the obstacle's radius and the gripper link's radius;
+the paper's obstacles are points and lines, for which the two agree), floored
+at 1 mm; a bar's shortest distance is to the closest point of its segment.
+The integration stops early when the path stalls in a local minimum (progress
+below 1 mm over 50 steps); the policy then drives the rest of the way
+straight to the fruit, as the paper's program always did.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motiongym.envs.geometry import closest_point_on_segment
+
+
+@dataclass(frozen=True)
+class FieldParameters:
+    """``rho0`` (m), ``m`` (-), ``k rho0`` (m) of one row of Tables 1-2."""
+
+    rho0: float
+    m: float
+    k_rho0: float
+
+    @property
+    def eta(self) -> float:
+        return eta_from_eq6(self.m, self.k_rho0, self.rho0)
+
+
+TRAJECTORY = FieldParameters(rho0=0.2, m=0.6, k_rho0=0.1)  # Table 1, trajectory generation
+TARGET = FieldParameters(rho0=0.4, m=1.0, k_rho0=0.2)  # Table 1, target direction
+AVOIDANCE = FieldParameters(rho0=0.2, m=0.6, k_rho0=0.1)  # Table 1, obstacle avoidance
+
+_RHO_FLOOR = 1e-3  # m
+
+
+def eta_from_eq6(m: float, k_rho0: float, rho0: float) -> float:
+    """Eq. 6 solved for eta: ``m (k rho0)^2 / (1/(k rho0) - 1/rho0)``."""
+    if not 0.0 < k_rho0 < rho0:
+        raise ValueError(f"need 0 < k*rho0 < rho0, got k*rho0={k_rho0}, rho0={rho0}")
+    return m * k_rho0**2 / (1.0 / k_rho0 - 1.0 / rho0)
+
+
+def obstacle_magnitude(rho: np.ndarray, params: FieldParameters = AVOIDANCE) -> np.ndarray:
+    """Eq. 5: ``eta (1/rho - 1/rho0) / rho^2`` inside ``rho0``, else 0 (any shape)."""
+    rho = np.maximum(np.asarray(rho, float), _RHO_FLOOR)
+    value = params.eta * (1.0 / rho - 1.0 / params.rho0) / rho**2
+    return np.where(rho <= params.rho0, value, 0.0)
+
+
+def target_magnitude(d: float, params: FieldParameters = TARGET) -> float:
+    """Eq. 4: ``1 + eta_t (1/d - 1/d0) / d^2`` inside ``d0``, else 1."""
+    d = max(float(d), _RHO_FLOOR)
+    if d > params.rho0:
+        return 1.0
+    return 1.0 + params.eta * (1.0 / d - 1.0 / params.rho0) / d**2
+
+
+def field_direction(
+    x: np.ndarray,
+    fruit: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    radius: np.ndarray,
+    gripper_radius: float = 0.0,
+    trajectory: FieldParameters = TRAJECTORY,
+    target: FieldParameters = TARGET,
+) -> np.ndarray:
+    """Eq. 7's unit direction ``v`` at gripper position ``x`` (dim,).
+
+    Obstacles are segments ``a``-``b`` (K, dim) of ``radius`` (K,); a sphere
+    has ``a == b``.
+    """
+    to_fruit = fruit - x
+    d = float(np.linalg.norm(to_fruit))
+    if d < 1e-12:
+        return np.zeros_like(x)
+    v = target_magnitude(d, target) * to_fruit / d
+    if len(radius):
+        dist, closest = closest_point_on_segment(x, a, b)  # (K,), (K, dim)
+        rho = dist - radius - gripper_radius
+        mag = obstacle_magnitude(rho, trajectory)  # (K,)
+        away = (x - closest) / np.maximum(dist, 1e-12)[:, None]  # (K, dim)
+        v = v + (mag[:, None] * away).sum(axis=0)
+    n = float(np.linalg.norm(v))
+    return v / n if n > 1e-12 else np.zeros_like(x)
+
+
+def plan_path(
+    start: np.ndarray,
+    fruit: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    radius: np.ndarray,
+    speed: float = 0.2,
+    step: float = 0.05,
+    gripper_radius: float = 0.0,
+    tolerance: float = 0.005,
+    max_steps: int = 1000,
+) -> np.ndarray:
+    """RK4 integral of eq. 7 from ``start`` to ``fruit``: path points (N, dim).
+
+    ``speed`` is ``|V_end_ref|`` (m/s) and ``step`` the time step (s), so
+    consecutive points are about ``speed * step`` apart. The last point is
+    the fruit when the path arrives within ``tolerance``.
+    """
+    x = np.asarray(start, float).copy()
+    fruit = np.asarray(fruit, float)
+
+    def f(p: np.ndarray) -> np.ndarray:
+        return speed * field_direction(p, fruit, a, b, radius, gripper_radius)
+
+    path = [x.copy()]
+    h = step
+    for i in range(max_steps):
+        if np.linalg.norm(fruit - x) <= max(tolerance, speed * h):
+            break
+        k1 = f(x)
+        k2 = f(x + 0.5 * h * k1)
+        k3 = f(x + 0.5 * h * k2)
+        k4 = f(x + h * k3)
+        x = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        path.append(x.copy())
+        if i >= 50 and np.linalg.norm(fruit - path[-51]) - np.linalg.norm(fruit - x) < 1e-3:
+            break  # stalled in a local minimum
+    if np.linalg.norm(fruit - x) <= max(tolerance, speed * h):
+        path.append(fruit.copy())
+    return np.array(path)

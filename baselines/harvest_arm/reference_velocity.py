@@ -1,0 +1,125 @@
+"""Reference velocities of the joint points (paper eq. 8-11).
+
+The arm is a chain of joint points ``X_0 .. X_L`` (base to gripper); link
+``i`` is the segment ``X_i X_{i+1}`` with ``U = X_{i+1} - X_i`` and
+``u = U / |U|``; ``v`` is the unit direction of the gripper's travel.
+
+* Trajectory following (eq. 8): ``w_d = (v x u) x u``. That vector is
+  ``-(v - (v.u) u)``; we use ``+(v - (v.u) u)``, the component of ``v``
+  perpendicular to the link, applied at the link's distal point, which is
+  the point the link's rotation moves. With that sign a joint moves the way
+  the gripper went and the joints trace the gripper's path (paper Fig. 3;
+  tested); with the printed sign they move against it.
+* Point obstacle (eq. 9): ``C = Ob_j - X_i``; the term acts when the
+  obstacle projects onto the link (``0 <= C.U <= |U|^2``) and its distance
+  ``rho`` to the link's line is below ``rho0``. Direction
+  ``(C x u) x u`` normalised, i.e. perpendicular to the link, away from the
+  obstacle; magnitude eq. 5 with the obstacle-avoidance row of Tables 1-2.
+* Bar obstacle (eq. 10): direction the common normal of link and bar,
+  ``(C x U) / |C x U|``, oriented away from the bar, ``rho`` the distance
+  along it. The printed applicability test (two sign products of
+  ``C_1, C_2, C_3``) is OCR-damaged; we implement its meaning, "the common
+  perpendicular falls inside both segments": the closest points of the two
+  segments are interior to both, and then the common normal is the
+  direction between them (which also serves in 2-D).
+* Combination (eq. 11): ``w = w_d + sum w_ob``, normalised only when
+  ``|w| > 1``; ``X_i_dot = |V_i_ref| w``.
+
+Where the paper is silent: ``rho`` is the surface clearance (line or
+segment distance minus the link and obstacle radii); each link's terms go to
+its distal point, except the last link's, whose distal point is the gripper
+(bound to its own path by eq. 1): its obstacle terms go to its proximal
+point. ``|V_i_ref|`` is the gripper's reference speed for every point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from motiongym.baselines.harvest_arm.potential_field import (
+    AVOIDANCE,
+    FieldParameters,
+    obstacle_magnitude,
+)
+from motiongym.envs.geometry import closest_points_between_segments
+
+_EPS = 1e-12
+
+
+def _links(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Link vectors U (L, dim), lengths (L,), unit u (L, dim)."""
+    U = points[1:] - points[:-1]
+    length = np.linalg.norm(U, axis=-1)
+    return U, length, U / np.maximum(length, _EPS)[:, None]
+
+
+def _to_points(per_link: np.ndarray) -> np.ndarray:
+    """Move each link's term to the point it drives: (L, dim) -> (P, dim)."""
+    L, dim = per_link.shape
+    out = np.zeros((L + 1, dim))
+    out[:L] += per_link  # proximal points (the paper's X_i)
+    out[1:L] += per_link[: L - 1]  # distal points, except the gripper
+    return out
+
+
+def trajectory_following(points: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Eq. 8 direction ``w_d`` at every point (P, dim); zero at base and gripper."""
+    _, _, u = _links(points)
+    w = v[None, :] - (u @ v)[:, None] * u  # (L, dim): v perpendicular to each link
+    out = np.zeros_like(points)
+    out[1:-1] = w[:-1]  # distal point of links 0 .. L-2; the gripper follows its path
+    return out
+
+
+def point_obstacle_terms(
+    points: np.ndarray,
+    centres: np.ndarray,
+    radius: np.ndarray,
+    link_radius: float = 0.0,
+    params: FieldParameters = AVOIDANCE,
+) -> np.ndarray:
+    """Eq. 9 terms ``w_ob`` of sphere obstacles (K, dim), summed per point: (P, dim)."""
+    if len(centres) == 0:
+        return np.zeros_like(points)
+    U, length, u = _links(points)
+    C = centres[None, :, :] - points[:-1, None, :]  # (L, K, dim)
+    along = np.einsum("lkd,ld->lk", C, U)  # C.U
+    perp = C - np.einsum("lkd,ld->lk", C, u)[..., None] * u[:, None, :]  # (L, K, dim)
+    dist = np.linalg.norm(perp, axis=-1)  # distance to the link's line
+    rho = dist - radius[None, :] - link_radius
+    inside = (along >= 0.0) & (along <= length[:, None] ** 2) & (rho < params.rho0)
+    mag = np.where(inside, obstacle_magnitude(rho, params), 0.0)  # (L, K)
+    away = -perp / np.maximum(dist, _EPS)[..., None]  # ((C x u) x u) normalised
+    return _to_points((mag[..., None] * away).sum(axis=1))
+
+
+def bar_obstacle_terms(
+    points: np.ndarray,
+    a: np.ndarray,
+    b: np.ndarray,
+    radius: np.ndarray,
+    link_radius: float = 0.0,
+    params: FieldParameters = AVOIDANCE,
+) -> np.ndarray:
+    """Eq. 10 terms ``w_obl`` of bar obstacles ``a``-``b`` (K, dim), per point: (P, dim)."""
+    if len(a) == 0:
+        return np.zeros_like(points)
+    p0, p1 = points[:-1, None, :], points[1:, None, :]  # (L, 1, dim)
+    dist, on_link, on_bar = closest_points_between_segments(p0, p1, a[None], b[None])  # (L, K)
+    d1, d2 = p1 - p0, (b - a)[None]
+    s = np.einsum("lkd,lkd->lk", on_link - p0, np.broadcast_to(d1, on_link.shape))
+    s = s / np.maximum(np.sum(d1 * d1, axis=-1), _EPS)
+    t = np.einsum("lkd,lkd->lk", on_bar - a[None], np.broadcast_to(d2, on_bar.shape))
+    t = t / np.maximum(np.sum(d2 * d2, axis=-1), _EPS)
+    interior = (s > 1e-9) & (s < 1 - 1e-9) & (t > 1e-9) & (t < 1 - 1e-9)
+    rho = dist - radius[None, :] - link_radius
+    mag = np.where(interior & (rho < params.rho0), obstacle_magnitude(rho, params), 0.0)
+    away = (on_link - on_bar) / np.maximum(dist, _EPS)[..., None]  # common normal, off the bar
+    return _to_points((mag[..., None] * away).sum(axis=1))
+
+
+def combine(w_d: np.ndarray, w_ob: np.ndarray, speed: float) -> np.ndarray:
+    """Eq. 11: ``|V_ref| (w_d + w_ob)``, the sum normalised where its norm exceeds 1."""
+    w = w_d + w_ob
+    norm = np.linalg.norm(w, axis=-1, keepdims=True)
+    return speed * np.where(norm > 1.0, w / np.maximum(norm, _EPS), w)
