@@ -1,5 +1,10 @@
-"""Scripted reference policies for the sweeper world."""
+"""Scripted reference policies for the sweeper world (paper 003, Park & Lee 1998)."""
 
 from __future__ import annotations
 
-POLICIES: dict[str, dict[str, str]] = {}
+POLICIES: dict[str, dict[str, str]] = {
+    "motiongym/Sweeper-v0": {
+        "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
+        "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
+    },
+}

@@ -1,0 +1,74 @@
+"""The robot's own maps, built from what it senses (paper 3.1 sweep map, 3.3 obstacle map).
+
+The sweeper knows nothing of the area in advance. Each observation's
+``sensed`` window (obstacles around the footprint) and ``swept`` window are
+written into full-resolution maps at the believed pose; the footprint is
+marked swept. Planning works on the bounding box of what has been sensed,
+padded by the robot width, so its cost follows the explored area, not the
+largest allowed map.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from motiongym.envs.sweeper.maps import MAX_SIDE
+
+UNKNOWN, FREE, OBSTACLE = -1, 0, 1
+
+
+class RobotMap:
+    """Occupancy (unknown / free / obstacle) and sweep maps in the map frame.
+
+    Args:
+        w: robot width (cells).
+        sensor_range: cells sensed beyond the footprint (R); the windows are
+            ``w + 2R`` cells wide.
+    """
+
+    def __init__(self, w: int, sensor_range: int) -> None:
+        self.w, self.R = int(w), int(sensor_range)
+        self.S = self.w + 2 * self.R
+        self.off = self.S + self.w  # array index = map cell + off
+        side = MAX_SIDE + 2 * self.off
+        self.occ = np.full((side, side), UNKNOWN, np.int8)  # (side, side)
+        self.swept = np.zeros((side, side), bool)  # (side, side)
+        self.lo = np.array([10**9, 10**9])  # bounding box of sensed cells (array index)
+        self.hi = np.array([-1, -1])
+
+    def integrate(self, obs: dict) -> tuple[int, int, int, bool]:
+        """Write one observation into the maps; return ``(row, col, heading, bump)``."""
+        pose = np.asarray(obs["pose"])
+        r, c, h = int(round(float(pose[0]))), int(round(float(pose[1]))), int(round(float(pose[2])))
+        bump = bool(pose[3] > 0.5)
+        o, R, S, w = self.off, self.R, self.S, self.w
+        r0, c0 = r - R + o, c - R + o
+        self.occ[r0 : r0 + S, c0 : c0 + S] = np.asarray(obs["sensed"]) > 0.5
+        self.swept[r0 : r0 + S, c0 : c0 + S] |= np.asarray(obs["swept"]) > 0.5
+        self.swept[r + o : r + o + w, c + o : c + o + w] = True
+        self.lo = np.minimum(self.lo, (r0, c0))
+        self.hi = np.maximum(self.hi, (r0 + S, c0 + S))
+        return r, c, h, bump
+
+    def mark_obstacle(self, cells_r: np.ndarray, cells_c: np.ndarray) -> None:
+        """Record obstacle cells (map frame), e.g. felt by a bump."""
+        self.occ[cells_r + self.off, cells_c + self.off] = OBSTACLE
+
+    def window(self) -> tuple[int, int, np.ndarray, np.ndarray]:
+        """``(r0, c0, occ, swept)``: the explored box padded by ``w``; ``r0, c0`` its map origin.
+
+        ``occ`` and ``swept`` are views of shape ``(h, w)`` of the box.
+        """
+        pad = self.w
+        lo = np.maximum(self.lo - pad, 0)
+        hi = np.minimum(self.hi + pad, self.occ.shape[0])
+        occ = self.occ[lo[0] : hi[0], lo[1] : hi[1]]
+        swept = self.swept[lo[0] : hi[0], lo[1] : hi[1]]
+        return int(lo[0] - self.off), int(lo[1] - self.off), occ, swept
+
+    def footprint(self, r: int, c: int) -> tuple[np.ndarray, np.ndarray]:
+        """Occupancy and sweep state of the footprint anchored at map cell ``(r, c)``."""
+        o, w = self.off, self.w
+        return self.occ[r + o : r + o + w, c + o : c + o + w], self.swept[
+            r + o : r + o + w, c + o : c + o + w
+        ]

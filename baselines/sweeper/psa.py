@@ -1,0 +1,142 @@
+"""Plane Sweeping Algorithm with a LIFO stack (paper section 3.1, Fig. 3-5).
+
+PSA, as the paper states it:
+
+1. Move straight, sweeping, until an obstacle or a wall blocks the robot.
+2. Alongside the segment just travelled, consider a virtual segment on each
+   side, one sweeping width away.
+3. If a side segment holds cells not yet swept, push its start point on a
+   stack.
+4. At the blocking point shift one sweeping width to the right or the left,
+   alternating, reverse the heading and go on (a boustrophedon). When no
+   shift is possible, pop the stack (LIFO: the latest point is usually the
+   nearest one), skip points already swept according to the sweep map, move
+   there (point-to-point transfer, :mod:`.quadtree`) and restart PSA; stop
+   when the stack is empty.
+
+Choices where the paper is open (documented and tested):
+
+- A lane also ends where the cells ahead are all swept already (the sweep
+  map is consulted, as in step 3): otherwise a restarted run would re-sweep
+  finished lanes until a wall.
+- "Right or left, alternating" relative to the heading is a constant side in
+  the map frame: the run's *shift side*. The first run shifts to the right of
+  the start heading; a run restarted from a popped segment shifts away from
+  the lane that pushed it.
+- A shift moves up to one sweeping width; a shorter shift (a wall nearer than
+  ``w``) is still a shift. The run ends when no shift cell is free or the new
+  lane holds nothing to sweep.
+- A pushed entry keeps its whole side segment (start, heading, length, side):
+  on popping, the restart point is the end of the segment's still-unswept
+  part that is nearer to the robot (the paper's "start point" taken from
+  whichever end the robot reaches first, in the spirit of its LIFO choice:
+  the nearest point first), and the run sweeps towards the other end. When
+  only the start point is stored, a segment whose start was swept later but
+  whose far end was not would be skipped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motiongym.envs.sweeper.world import DC, DR
+
+
+@dataclass(frozen=True)
+class Segment:
+    """A virtual side segment pushed on the PSA stack."""
+
+    start: tuple[int, int]  # configuration (footprint top-left cell), map frame
+    heading: int  # direction of travel along the segment (0 E, 1 N, 2 W, 3 S)
+    length: int  # configurations along it, start included
+    side: int  # the heading pointing away from the lane that pushed it
+
+
+def left_of(heading: int) -> int:
+    return (heading + 1) % 4
+
+
+def right_of(heading: int) -> int:
+    return (heading + 3) % 4
+
+
+def side_segments(
+    start: tuple[int, int], end: tuple[int, int], heading: int, w: int
+) -> list[Segment]:
+    """Step 2: the two virtual segments one sweeping width beside the lane ``start -> end``."""
+    length = abs(end[0] - start[0]) + abs(end[1] - start[1]) + 1
+    out = []
+    for side in (left_of(heading), right_of(heading)):
+        s = (start[0] + w * int(DR[side]), start[1] + w * int(DC[side]))
+        out.append(Segment(s, heading, length, side))
+    return out
+
+
+def segment_configs(seg: Segment) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of the configurations along ``seg``: ``(length,)`` each."""
+    k = np.arange(seg.length)
+    return seg.start[0] + k * int(DR[seg.heading]), seg.start[1] + k * int(DC[seg.heading])
+
+
+def covers_unswept(occ: np.ndarray, swept: np.ndarray, w: int) -> np.ndarray:
+    """``(H, W)`` bool: configurations whose footprint holds a cell neither swept nor obstacle."""
+    from motiongym.envs.sweeper.world import box_sum
+
+    todo = (~swept) & (occ != 1)
+    return box_sum(todo.astype(np.int64), w) > 0
+
+
+def first_target(
+    seg: Segment,
+    origin: tuple[int, int],
+    cfree: np.ndarray,
+    todo_cfg: np.ndarray,
+    dist: np.ndarray | None = None,
+) -> tuple[tuple[int, int], int] | None:
+    """Step 3 on popping: where along ``seg`` to restart, and the heading to sweep in.
+
+    ``cfree`` / ``todo_cfg``: configurations free in the known map / covering
+    unswept cells, as arrays whose cell ``[0, 0]`` is map cell ``origin``.
+    The candidates are the first and the last configuration along the
+    segment that are free and cover an unswept cell; with ``dist`` (grid
+    distances from the robot) the nearer one is taken and the run heads
+    towards the other, else the first one with the segment's heading.
+    Returns ``((row, col), heading)`` in the map frame, or None.
+    """
+    rr, cc = segment_configs(seg)
+    rr, cc = rr - origin[0], cc - origin[1]
+    h, wd = cfree.shape
+    inside = (rr >= 0) & (rr < h) & (cc >= 0) & (cc < wd)
+    rr, cc = rr[inside], cc[inside]
+    ok = cfree[rr, cc] & todo_cfg[rr, cc]
+    if not ok.any():
+        return None
+    idx = np.flatnonzero(ok)
+    first, last = int(idx[0]), int(idx[-1])
+    k, heading = first, seg.heading
+    if dist is not None and 0 <= dist[rr[last], cc[last]] < dist[rr[first], cc[first]]:
+        k, heading = last, (seg.heading + 2) % 4
+    return (int(rr[k] + origin[0]), int(cc[k] + origin[1])), heading
+
+
+def lane_open(occ_fp_next: np.ndarray, swept_edge: np.ndarray) -> bool:
+    """Step 1: the next configuration has no known obstacle and brings an unswept cell."""
+    return not (occ_fp_next == 1).any() and not swept_edge.all()
+
+
+class PsaStack:
+    """The LIFO stack of side segments (the paper prefers it to a FIFO queue)."""
+
+    def __init__(self) -> None:
+        self.items: list[Segment] = []
+
+    def push(self, seg: Segment) -> None:
+        self.items.append(seg)
+
+    def pop(self) -> Segment:
+        return self.items.pop()
+
+    def __len__(self) -> int:
+        return len(self.items)

@@ -1,0 +1,304 @@
+"""The paper's sweeping algorithm as a scripted policy: PSA + point-to-point + CWA (Fig. 2).
+
+Flow (paper Fig. 2): sweep with PSA (:mod:`.psa`), moving between runs with
+the quadtree point-to-point transfer (:mod:`.quadtree`) until the stack is
+empty; then sweep the leftovers along walls and obstacles with CWA
+(:mod:`.cwa`). The policy acts from the observation alone: it writes each
+``sensed``/``swept`` window into its own maps (:mod:`.belief`) at the
+believed ``pose`` and plans on those maps, treating unknown cells as free
+until sensed. Under odometry noise a bump marks the cells ahead as obstacle
+and the current plan is dropped.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.baselines.sweeper import cwa, psa, quadtree
+from motiongym.baselines.sweeper.belief import OBSTACLE, RobotMap
+from motiongym.envs.sweeper import world
+from motiongym.envs.sweeper.world import DC, DR
+
+FORWARD, LEFT, RIGHT = 0, 1, 2
+
+
+def turn_towards(heading: int, target: int) -> int:
+    """The turn action that brings ``heading`` closer to ``target`` (left on a reversal)."""
+    return RIGHT if (target - heading) % 4 == 3 else LEFT
+
+
+def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:
+    """``(w, R)``: the robot width (from the env's keywords) and sensing range (window size)."""
+    w = int(env_kwargs.get("robot_width", 3))
+    s = observation_space["sensed"].shape[0]
+    return w, (s - w) // 2
+
+
+@dataclass
+class Memory:
+    """One episode's state of the sweeping algorithm."""
+
+    map: RobotMap
+    mode: str = "lane"  # lane | shift | pop | transfer | cwa_scan | cwa_pop | cwa_follow | done
+    path: deque = field(default_factory=deque)  # configurations still to visit
+    goal: tuple[int, int] | None = None
+    run_heading: int | None = None
+    run_side: int | None = None
+    lane_start: tuple[int, int] | None = None
+    stack: psa.PsaStack = field(default_factory=psa.PsaStack)
+    cwa_stack: list = field(default_factory=list)
+    cwa_cells: np.ndarray | None = None
+    cwa_last: tuple[int, int] | None = None  # (swept cells, leftovers) at the last scan
+    started: bool = False
+    log: list = field(default_factory=list)  # (mode, pose) at each decision, for figures
+
+
+class PsaCwaPolicy(ScriptedPolicy):
+    """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
+
+    def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
+        super().__init__(observation_space, action_space, env_kwargs)
+        self.w, self.R = robot_geometry(observation_space, self.env_kwargs)
+
+    def new_memory(self) -> Memory:
+        return Memory(RobotMap(self.w, self.R))
+
+    # ----------------------------------------------------------------- acting
+    def act(self, observation: Any, memory: Memory) -> int:
+        m = memory
+        r, c, h, bump = m.map.integrate(observation)
+        if not m.started:
+            m.started = True
+            m.run_heading, m.run_side = h, psa.right_of(h)
+            m.lane_start = (r, c)
+        if bump:  # the cells ahead are blocked, whatever the map said
+            self._mark_ahead(m, r, c, h)
+            m.path.clear()
+        for _ in range(200):
+            a = self._follow(m, r, c, h)
+            if a is not None:
+                return a
+            a = getattr(self, "_" + m.mode)(m, r, c, h)
+            if a is not None:
+                return a
+        return LEFT  # pragma: no cover - a planning loop that does not settle
+
+    def _mark_ahead(self, m: Memory, r: int, c: int, h: int) -> None:
+        rr, cc = np.nonzero(world.entering_mask(int(DR[h]), int(DC[h]), self.w))
+        m.map.mark_obstacle(rr + r + int(DR[h]), cc + c + int(DC[h]))
+
+    def _follow(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        """Execute the planned path of configurations (turn towards, then forward)."""
+        while m.path and m.path[0] == (r, c):
+            m.path.popleft()
+        if not m.path:
+            return None
+        nr, nc = m.path[0]
+        occ, _ = m.map.footprint(nr, nc)
+        if abs(nr - r) + abs(nc - c) != 1 or (occ == OBSTACLE).any():
+            m.path.clear()  # blocked or off the path: the mode replans
+            return None
+        d = {(0, 1): 0, (-1, 0): 1, (0, -1): 2, (1, 0): 3}[(nr - r, nc - c)]
+        return FORWARD if d == h else turn_towards(h, d)
+
+    def _known(self, m: Memory, r: int, c: int):
+        """Known-map arrays on the explored box: origin, occupancy, swept, free configs, start."""
+        r0, c0, occ, swept = m.map.window()
+        cfree = world.config_free(occ == OBSTACLE, self.w)
+        cur = (r - r0, c - c0)
+        cfree[cur] = True  # the robot stands there, whatever the map says
+        return (r0, c0), occ, swept, cfree, cur
+
+    # -------------------------------------------------------------- PSA modes
+    def _lane(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        if h != m.run_heading:
+            return turn_towards(h, m.run_heading)
+        nr, nc = r + int(DR[h]), c + int(DC[h])
+        occ, sw = m.map.footprint(nr, nc)
+        edge = world.entering_mask(int(DR[h]), int(DC[h]), self.w)
+        if psa.lane_open(occ, sw[edge]):
+            return FORWARD  # step 1: straight on, sweeping
+        for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
+            if self._strip_unswept(m, seg):
+                m.stack.push(seg)
+        s, k = m.run_side, 0  # step 4: shift one width to the run's side
+        while k < self.w:
+            occ, _ = m.map.footprint(r + (k + 1) * int(DR[s]), c + (k + 1) * int(DC[s]))
+            if (occ == OBSTACLE).any():
+                break
+            k += 1
+        back = (h + 2) % 4
+        target = (r + k * int(DR[s]), c + k * int(DC[s]))
+        if k > 0 and self._lane_has_work(m, target, back):
+            m.path = deque((r + i * int(DR[s]), c + i * int(DC[s])) for i in range(1, k + 1))
+            m.goal, m.run_heading, m.mode = target, back, "shift"
+            return None
+        m.mode = "pop"
+        return None
+
+    def _strip_unswept(self, m: Memory, seg: psa.Segment) -> bool:
+        rr, cc = psa.segment_configs(seg)
+        o, w = m.map.off, self.w
+        r0, r1 = int(rr.min()) + o, int(rr.max()) + o + w
+        c0, c1 = int(cc.min()) + o, int(cc.max()) + o + w
+        if r0 < 0 or c0 < 0:
+            return False
+        occ, swept = m.map.occ[r0:r1, c0:c1], m.map.swept[r0:r1, c0:c1]
+        return bool(((~swept) & (occ != OBSTACLE)).any())
+
+    def _lane_has_work(self, m: Memory, cfg: tuple[int, int], heading: int) -> bool:
+        occ, sw = m.map.footprint(*cfg)
+        if ((~sw) & (occ != OBSTACLE)).any():
+            return True
+        nocc, nsw = m.map.footprint(cfg[0] + int(DR[heading]), cfg[1] + int(DC[heading]))
+        edge = world.entering_mask(int(DR[heading]), int(DC[heading]), self.w)
+        return psa.lane_open(nocc, nsw[edge])
+
+    def _shift(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        m.mode, m.lane_start = "lane", (r, c)
+        return None
+
+    def _pop(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        """Pop segments until one still holds work and can be reached; transfer there."""
+        if not len(m.stack):
+            m.mode = "cwa_scan"
+            return None
+        origin, occ, swept, cfree, cur = self._known(m, r, c)
+        dist = world.bfs_distance(cfree, cur)
+        todo = psa.covers_unswept(occ, swept, self.w)
+        while len(m.stack):
+            seg = m.stack.pop()
+            found = psa.first_target(seg, origin, dist >= 0, todo, dist)
+            if found is None:
+                continue  # already swept (the paper's skip) or out of reach
+            target, heading = found
+            path = quadtree.plan(cfree, cur, (target[0] - origin[0], target[1] - origin[1]))
+            if path is None:
+                continue
+            m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
+            m.goal, m.run_heading, m.run_side = target, heading, seg.side
+            m.mode = "transfer"
+            m.log.append(("transfer", (r, c), target))
+            return None
+        m.mode = "cwa_scan"
+        return None
+
+    def _transfer(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        if (r, c) != m.goal:  # the path was blocked: plan again
+            origin, _, _, cfree, cur = self._known(m, r, c)
+            goal = (m.goal[0] - origin[0], m.goal[1] - origin[1])
+            ok = 0 <= goal[0] < cfree.shape[0] and 0 <= goal[1] < cfree.shape[1]
+            path = quadtree.plan(cfree, cur, goal) if ok and cfree[goal] else None
+            if path is None:
+                m.mode = "pop"
+                return None
+            m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
+            return None
+        m.mode, m.lane_start = "lane", (r, c)
+        return None
+
+    # -------------------------------------------------------------- CWA modes
+    def _cwa_scan(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        origin, occ, swept, cfree, cur = self._known(m, r, c)
+        reach = world.reachable_configs(cfree, cur)
+        targets = cwa.leftovers(occ, swept, reach, self.w)
+        state = (int(m.map.swept.sum()), int(targets.sum()))
+        if not targets.any() or state == m.cwa_last:
+            m.mode = "done"
+            return None
+        m.cwa_last = state
+        wide = (world.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
+        if wide.any():  # a region PSA missed, not a corner: restart PSA there
+            return self._restart_psa(m, r, c, origin, cfree, cur, wide, targets)
+        m.cwa_stack = [
+            ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
+            for s, cells in cwa.scan_groups(targets)
+        ]
+        m.mode = "cwa_pop"
+        return None
+
+    def _restart_psa(self, m: Memory, r, c, origin, cfree, cur, wide, targets) -> None:
+        """Transfer to the nearest wide leftover and sweep it with a new PSA run.
+
+        The run's heading is the one with the longest stretch of leftover
+        configurations ahead; its shift side the perpendicular with more
+        leftover cells beside the first lane.
+        """
+        dist = world.bfs_distance(cfree, cur)
+        d = np.where(wide & (dist >= 0), dist, np.iinfo(np.int64).max)
+        target = divmod(int(np.argmin(d)), d.shape[1])
+        todo = psa.covers_unswept(np.where(targets, 0, 1), targets, self.w) & cfree
+        h, wd = todo.shape
+
+        def run_length(k: int, cfg: tuple[int, int]) -> int:
+            n, (rr, cc) = 0, cfg
+            while True:
+                rr, cc = rr + int(DR[k]), cc + int(DC[k])
+                if not (0 <= rr < h and 0 <= cc < wd and todo[rr, cc]):
+                    return n
+                n += 1
+
+        heading = max(range(4), key=lambda k: run_length(k, target))
+        side = max(
+            (psa.left_of(heading), psa.right_of(heading)), key=lambda k: run_length(k, target)
+        )
+        path = quadtree.plan(cfree, cur, target)
+        m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
+        m.goal = (target[0] + origin[0], target[1] + origin[1])
+        m.run_heading, m.run_side, m.mode = heading, side, "transfer"
+        m.log.append(("restart", (r, c), m.goal))
+
+    def _remaining(self, m: Memory, cells: np.ndarray) -> np.ndarray:
+        o = m.map.off
+        occ = m.map.occ[cells[:, 0] + o, cells[:, 1] + o]
+        swept = m.map.swept[cells[:, 0] + o, cells[:, 1] + o]
+        return cells[(~swept) & (occ != OBSTACLE)]
+
+    def _cwa_pop(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        while m.cwa_stack:
+            seed, cells = m.cwa_stack.pop()
+            cells = self._remaining(m, cells)
+            if not len(cells):
+                continue
+            origin, _, _, cfree, cur = self._known(m, r, c)
+            dist = world.bfs_distance(cfree, cur)
+            first = self._remaining(m, np.array([seed]))
+            aim = first if len(first) else cells
+            target = cwa.nearest_cover(dist, aim - np.array(origin), self.w)
+            if target is None:
+                continue
+            path = quadtree.plan(cfree, cur, target)
+            if path is None:  # pragma: no cover - BFS found it, the quadtree must too
+                continue
+            m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
+            m.cwa_cells, m.mode = cells, "cwa_follow"
+            m.log.append(("cwa", (r, c), (target[0] + origin[0], target[1] + origin[1])))
+            return None
+        m.mode = "cwa_scan"
+        return None
+
+    def _cwa_follow(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        cells = self._remaining(m, m.cwa_cells)
+        m.cwa_cells = cells
+        if not len(cells):
+            m.mode = "cwa_pop"
+            return None
+        origin, _, _, cfree, cur = self._known(m, r, c)
+        dist = world.bfs_distance(cfree, cur)
+        target = cwa.nearest_cover(dist, cells - np.array(origin), self.w)
+        if target is None:
+            m.mode = "cwa_pop"
+            return None
+        m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in world.descend(dist, target))
+        if not m.path:  # standing on it, yet cells remain: they are not coverable from here
+            m.mode = "cwa_pop"
+        return None
+
+    def _done(self, m: Memory, r: int, c: int, h: int) -> int:
+        return LEFT  # nothing left that the robot knows of: turn in place

@@ -1,0 +1,150 @@
+"""Point-to-point transfer by approximate cell decomposition with a quadtree (paper 3.2).
+
+The paper moves the robot between sweeping runs with "approximate cell
+decomposition" over a quadtree (Latombe, *Robot Motion Planning*, ch. 6): the
+known workspace is split recursively into squares until each square is
+wholly free or wholly blocked (down to single cells); a path is a chain of
+adjacent free squares, searched with A* between square centres. The
+decomposition is complete at cell resolution: whenever a 4-connected path
+of free cells exists, a chain of free leaves exists.
+
+Here the decomposition runs in configuration space: a cell of ``free`` is a
+robot configuration whose whole footprint is free (obstacles grown by the
+robot, as in the paper's bitmap simulation). The chain of squares is turned
+into cell moves: inside a free square any monotone (L-shaped) path between
+two of its cells stays in it, so the path goes from the current cell to the
+exit cell facing the next square, steps across, and so on to the goal.
+"""
+
+from __future__ import annotations
+
+import heapq
+
+import numpy as np
+
+
+def decompose(free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quadtree leaves of ``free``.
+
+    Returns:
+        ``(leaves, label)``: ``leaves`` an ``(n, 3)`` int array of free squares
+        ``(row, col, size)``; ``label`` an ``(H, W)`` int array giving each
+        cell's leaf index (-1 for blocked cells).
+    """
+    h, w = free.shape
+    n = 1
+    while n < max(h, w):
+        n *= 2
+    sat = np.zeros((n + 1, n + 1), np.int64)  # summed-area table of blocked cells
+    blocked = np.ones((n, n), np.int64)
+    blocked[:h, :w] = ~free
+    sat[1:, 1:] = blocked.cumsum(0).cumsum(1)
+    leaves: list[tuple[int, int, int]] = []
+    stack = [(0, 0, n)]
+    while stack:
+        r, c, s = stack.pop()
+        count = sat[r + s, c + s] - sat[r, c + s] - sat[r + s, c] + sat[r, c]
+        if count == s * s:
+            continue
+        if count == 0:
+            leaves.append((r, c, s))
+            continue
+        half = s // 2
+        stack.extend(
+            ((r, c, half), (r, c + half, half), (r + half, c, half), (r + half, c + half, half))
+        )
+    label = np.full((h, w), -1, np.int64)
+    for i, (r, c, s) in enumerate(leaves):
+        label[r : r + s, c : c + s] = i
+    return np.array(leaves, np.int64).reshape(-1, 3), label
+
+
+def _adjacency(label: np.ndarray) -> dict[int, set[int]]:
+    pairs = []
+    for a, b in ((label[:, :-1], label[:, 1:]), (label[:-1, :], label[1:, :])):
+        m = (a >= 0) & (b >= 0) & (a != b)
+        pairs.append(np.stack([a[m], b[m]], axis=1))
+    both = np.unique(np.concatenate(pairs), axis=0)
+    adj: dict[int, set[int]] = {}
+    for a, b in both.tolist():
+        adj.setdefault(a, set()).add(b)
+        adj.setdefault(b, set()).add(a)
+    return adj
+
+
+def leaf_chain(
+    leaves: np.ndarray, label: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
+) -> list[int] | None:
+    """A* over the leaves' adjacency, cost = distance between square centres."""
+    a, b = int(label[start]), int(label[goal])
+    if a < 0 or b < 0:
+        return None
+    if a == b:
+        return [a]
+    centre = leaves[:, :2] + leaves[:, 2:3] / 2.0
+    adj = _adjacency(label)
+    best = {a: 0.0}
+    parent = {a: -1}
+    heap = [(float(np.linalg.norm(centre[a] - centre[b])), a)]
+    while heap:
+        _, u = heapq.heappop(heap)
+        if u == b:
+            chain = [b]
+            while parent[chain[-1]] >= 0:
+                chain.append(parent[chain[-1]])
+            return chain[::-1]
+        for v in adj.get(u, ()):
+            g = best[u] + float(np.linalg.norm(centre[u] - centre[v]))
+            if g < best.get(v, np.inf):
+                best[v], parent[v] = g, u
+                heapq.heappush(heap, (g + float(np.linalg.norm(centre[v] - centre[b])), v))
+    return None
+
+
+def _l_path(p: tuple[int, int], q: tuple[int, int]) -> list[tuple[int, int]]:
+    """Cells from ``p`` (excluded) to ``q``: along the longer axis first, then the other."""
+    (r, c), (qr, qc) = p, q
+    out = []
+    order = ("c", "r") if abs(qc - c) >= abs(qr - r) else ("r", "c")
+    for axis in order:
+        if axis == "r":
+            step = 1 if qr > r else -1
+            while r != qr:
+                r += step
+                out.append((r, c))
+        else:
+            step = 1 if qc > c else -1
+            while c != qc:
+                c += step
+                out.append((r, c))
+    return out
+
+
+def plan(
+    free: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
+) -> list[tuple[int, int]] | None:
+    """Cells from ``start`` (excluded) to ``goal`` over ``free`` (4-connected), or None."""
+    leaves, label = decompose(free)
+    chain = leaf_chain(leaves, label, start, goal)
+    if chain is None:
+        return None
+    path: list[tuple[int, int]] = []
+    p = start
+    for u, v in zip(chain[:-1], chain[1:], strict=True):
+        ur, uc, us = leaves[u].tolist()
+        vr, vc, vs = leaves[v].tolist()
+        if vc == uc + us or vc + vs == uc:  # side by side: share rows
+            lo, hi = max(ur, vr), min(ur + us, vr + vs) - 1
+            row = min(max(p[0], lo), hi)
+            exit_ = (row, uc + us - 1) if vc == uc + us else (row, uc)
+            entry = (row, vc) if vc == uc + us else (row, vc + vs - 1)
+        else:  # one above the other: share columns
+            lo, hi = max(uc, vc), min(uc + us, vc + vs) - 1
+            col = min(max(p[1], lo), hi)
+            exit_ = (ur + us - 1, col) if vr == ur + us else (ur, col)
+            entry = (vr, col) if vr == ur + us else (vr + vs - 1, col)
+        path += _l_path(p, exit_)
+        path.append(entry)
+        p = entry
+    path += _l_path(p, goal)
+    return path
