@@ -1,0 +1,150 @@
+"""The collision map of paper section III (after Lee & Lee 1987), evaluated lazily.
+
+Axes: ``s1`` is robot 1's controller sample (``t = s1 * dt``), ``s2`` robot 2's
+discretised travelled length (``l = s2 * dl``, ``dl = L_T / N_l``). Cell
+``(s1, s2)`` is a collision cell iff ``d(R1, R2) <= margin`` (paper eq. 2)
+with robot 1 at its sample ``min(s1, N1)`` (it rests at its end once done)
+and robot 2 at travelled length ``s2 * dl``. Cells are computed on demand and
+cached; :attr:`CollisionMap.evaluated` counts the distinct cells computed
+(the measure of the boundary-following method's cost). Outside the map
+``s1 < 0``, ``s2 < 0`` and ``s2 > N_l`` are walls (blocked): robot 2 cannot
+run before its start or past its end.
+
+TLVST (travelled length versus sampling time): ``tl[k] = floor(l(k dt) / dl)``,
+the level robot 2 has reached at its own sample ``k`` (``tl[N2] = N_l``). As a
+path of the paper's moves "0" (+s1) and "1" (+s2), the curve delayed by ``D``
+samples is: along ``s2 = 0`` from ``s1 = 0`` to ``D`` (robot 2 waits), then at
+each column ``D + k`` up from ``tl[k]`` to ``tl[k + 1]`` and one step right,
+and once robot 2 is done along ``s2 = N_l`` until robot 1 is done too
+(``s1 = max(N1, D + N2)``). A delay is collision free iff every cell of that
+path is free; with a pause-and-resume schedule ``p(s1)`` (robot 2's sample at
+column ``s1``), column ``s1`` covers levels ``tl[p(s1)] .. tl[p(s1 + 1)]``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from motiongym.envs.dual_arm import model
+from motiongym.envs.dual_arm.task import Trajectory
+
+CellFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+class CollisionMap:
+    """Lazy, counting collision map.
+
+    Args:
+        cells: vectorised occupancy ``(s1 (n,), s2 (n,)) -> bool (n,)`` for
+            in-range indices (``0 <= s1 <= n1``, ``0 <= s2 <= n_levels``).
+        n1: robot 1's last sample ``N1``.
+        tlvst: (N2 + 1,) robot 2's TLVST levels, non-decreasing, last = ``n_levels``.
+        n_levels: ``N_l``.
+    """
+
+    def __init__(self, cells: CellFunction, n1: int, tlvst: np.ndarray, n_levels: int) -> None:
+        tl = np.asarray(tlvst, dtype=np.int64)
+        if tl[0] != 0 or tl[-1] != n_levels or np.any(np.diff(tl) < 0):
+            raise ValueError("tlvst must start at 0, end at n_levels and never decrease")
+        self._cells = cells
+        self.n1 = int(n1)
+        self.n2 = len(tl) - 1
+        self.n_levels = int(n_levels)
+        self.tl = tl
+        self._known = np.full((self.n1 + 1, self.n_levels + 1), -1, dtype=np.int8)
+        self.evaluated = 0
+        # first_col[s2]: the first column a(s2) of the undelayed curve at level s2.
+        nxt = np.append(tl[1:], n_levels)
+        self.first_col = np.searchsorted(nxt, np.arange(n_levels + 1), side="left")
+        self.first_col[0] = 0
+
+    # ------------------------------------------------------------------ building
+
+    @classmethod
+    def from_tasks(
+        cls, traj1: Trajectory, traj2: Trajectory, n_levels: int = 100, margin: float = 0.0
+    ) -> CollisionMap:
+        """The map of two arms' tasks (the link geometry of ``envs.dual_arm.model``)."""
+        q1 = traj1.samples()  # (N1 + 1, 6)
+        q2, tl, _ = traj2.length_parametrised(n_levels)  # (N_l + 1, 6), (N2 + 1,)
+        a1, b1 = model.link_segments(q1, model.base_transform(0))  # (N1+1, 5, 3)
+        a2, b2 = model.link_segments(q2, model.base_transform(1))  # (N_l+1, 5, 3)
+
+        def cells(s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
+            return model.segments_collide(a1[s1], b1[s1], a2[s2], b2[s2], margin)
+
+        return cls(cells, traj1.n_samples, tl, n_levels)
+
+    @classmethod
+    def from_array(cls, occupied: np.ndarray, tlvst: np.ndarray) -> CollisionMap:
+        """A map given in full as a bool array (N1 + 1, N_l + 1) (for tests)."""
+        occ = np.asarray(occupied, dtype=bool)
+        return cls(lambda s1, s2: occ[s1, s2], occ.shape[0] - 1, tlvst, occ.shape[1] - 1)
+
+    # ------------------------------------------------------------------ queries
+
+    @property
+    def full_count(self) -> int:
+        """Number of distinct cells of the full map, ``(N1 + 1) (N_l + 1)``."""
+        return self._known.size
+
+    def blocked(self, s1: int, s2: int) -> bool:
+        """Collision (or wall) at ``(s1, s2)``; evaluates and caches the cell."""
+        if s1 < 0 or s2 < 0 or s2 > self.n_levels:
+            return True
+        s1 = min(s1, self.n1)
+        known = self._known[s1, s2]
+        if known < 0:
+            known = int(self._cells(np.array([s1]), np.array([s2]))[0])
+            self._known[s1, s2] = known
+            self.evaluated += 1
+        return bool(known)
+
+    def full(self) -> np.ndarray:
+        """Every cell, (N1 + 1, N_l + 1) bool (evaluates all unknown cells at once)."""
+        todo = np.argwhere(self._known < 0)
+        if len(todo):
+            for chunk in np.array_split(todo, max(1, len(todo) // 4096)):
+                self._known[chunk[:, 0], chunk[:, 1]] = self._cells(chunk[:, 0], chunk[:, 1])
+            self.evaluated += len(todo)
+        return self._known.astype(bool)
+
+    def column(self, s1: int) -> np.ndarray:
+        """Occupancy of column ``s1`` (clamped to ``N1``) from the full map."""
+        return self.full()[min(s1, self.n1)]
+
+    # ------------------------------------------------------------------ the TLVST curve
+
+    def end_column(self, delay: int) -> int:
+        return max(self.n1, delay + self.n2)
+
+    def curve(self, delay: int) -> tuple[np.ndarray, np.ndarray]:
+        """Cells of the TLVST path delayed by ``delay``, in order: ``(s1s, s2s)``."""
+        s1s: list[np.ndarray] = [np.arange(delay)]
+        s2s: list[np.ndarray] = [np.zeros(delay, dtype=np.int64)]
+        for k in range(self.n2):
+            lo, hi = self.tl[k], self.tl[k + 1]
+            s2s.append(np.arange(lo, hi + 1))
+            s1s.append(np.full(hi - lo + 1, delay + k))
+        tail = np.arange(delay + self.n2, self.end_column(delay) + 1)
+        s1s.append(tail)
+        s2s.append(np.full(len(tail), self.n_levels))
+        return np.concatenate(s1s).astype(np.int64), np.concatenate(s2s).astype(np.int64)
+
+    def next_on_curve(self, s1: int, s2: int, delay: int) -> int | None:
+        """The TLVST move ("0" or "1") from ``(s1, s2)`` on the curve delayed by
+        ``delay``; ``None`` at its end."""
+        if s2 >= self.n_levels:
+            return 0 if s1 < self.end_column(delay) else None
+        k = s1 - delay
+        if k >= self.n2:
+            return 1
+        if k < 0 or s2 >= self.tl[k + 1]:
+            return 0
+        return 1
+
+    def departure_delay(self, s1: int, s2: int) -> int:
+        """The delay whose curve enters level ``s2`` at column ``s1``: ``s1 - a(s2)``."""
+        return int(s1 - self.first_col[s2])

@@ -1,0 +1,209 @@
+"""``motiongym/DualArmCell-v0``: two PUMA-560 arms sharing a cell (Gymnasium)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from motiongym.envs.dual_arm import task as task_module
+from motiongym.envs.dual_arm.task import DT, TASK_MODES
+from motiongym.envs.dual_arm.world import OBS, DualArmWorld, observation_bounds
+
+CONTROLS = ("both", "robot_2")
+OPTIONS = ("task",)
+
+
+class DualArmCellEnv(gym.Env):
+    """Two PUMA-560 arms, each on a fixed pick-and-place trajectory; avoid collisions
+    by timing alone (Chang, Chung & Lee: time delay by boundary following).
+
+    Each arm follows a joint trajectory planned without regard to the other
+    (vias and a quintic time law, sampled at 20 ms). The agent never changes a
+    path: each step (20 ms) it chooses how far each arm advances along its own
+    trajectory, 0 (wait) to 1 (one sample, nominal speed). The paper's answer
+    is to start robot 2 late by the smallest delay that avoids collision.
+
+    ## Action
+    ``control="both"``: Box(0, 1, (2,)) float32: advance of robot 1, robot 2
+    (samples per step). ``control="robot_2"`` (the paper's setting): Box(0, 1,
+    (1,)): robot 2's advance; robot 1 runs on its nominal schedule. Values are
+    clipped into [0, 1] (never faster, never backwards); NaN or a wrong shape
+    raises ``ValueError``.
+
+    ## Observation
+    Box (94,) float32; see :mod:`motiongym.envs.dual_arm.world` for the table:
+    both arms' joints (rad), progress fractions, elapsed time (s), the 25 link
+    pair distances ``d_ij`` (m), and both tasks in compact form (4 via
+    configurations, 3 segment durations each), from which a planner rebuilds
+    the trajectories (``world.tasks_from_observation``) and the collision map.
+
+    ## Reward
+    Sum of named terms, each in ``info`` as ``reward_<term>``, weighted by the
+    keyword argument of the same name:
+
+    * ``time``: ``-time * 0.02`` per step (s of makespan; every step counts,
+      since the episode ends when both arms are done);
+    * ``collision``: ``-collision`` on the step that collides;
+    * ``clearance``: ``-clearance * max(0, 1 - d / clearance_distance)``,
+      ``d = d(R1, R2)``.
+
+    ## Episode
+    Terminated when both arms are done (success) or on collision
+    (``d(R1, R2) <= safety_margin``, paper eq. 2). Truncation is left to
+    ``TimeLimit`` (``max_episode_steps=1000``, 20 s).
+
+    ## Info
+    ``is_success`` (both done, no collision), ``cost`` (1.0 on a colliding
+    step), ``collision``, ``distance`` (``d(R1, R2)``, m), ``makespan`` (s
+    elapsed so far; the makespan when done), ``progress_1``/``progress_2``
+    (samples), ``robot_2_wait`` (s robot 2 spent not advancing before it was
+    done), and the reward terms.
+
+    ## Arguments
+    ``control`` ("both" | "robot_2"), ``task`` ("colliding": pairs that collide
+    if started together and are collision free one after the other; "any";
+    "paper": the fixed paper case), ``safety_margin`` (m), ``clearance_distance``
+    (m), reward weights ``time``, ``collision``, ``clearance``, ``render_mode``
+    ("rgb_array"). ``reset(options={"task": ...})`` overrides the task mode.
+
+    ## Version history
+    * v0: first version.
+    """
+
+    metadata = {
+        "render_modes": ["rgb_array"],
+        "render_fps": int(1 / DT),
+        "info_measures": {
+            "is_success": "last",
+            "cost": "sum",
+            "collision": "max",
+            "distance": "min",
+            "makespan": "last",
+            "robot_2_wait": "last",
+        },
+    }
+
+    def __init__(
+        self,
+        control: str = "both",
+        task: str = "colliding",
+        safety_margin: float = 0.0,  # m
+        clearance_distance: float = 0.05,  # m
+        time: float = 1.0,
+        collision: float = 10.0,
+        clearance: float = 0.1,
+        render_mode: str | None = None,
+    ) -> None:
+        if control not in CONTROLS:
+            raise ValueError(f"unknown control {control!r}; choose one of {', '.join(CONTROLS)}")
+        if task not in TASK_MODES:
+            raise ValueError(f"unknown task {task!r}; choose one of {', '.join(TASK_MODES)}")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"unknown render_mode {render_mode!r}; choose 'rgb_array' or None")
+        if clearance_distance <= 0:
+            raise ValueError("clearance_distance must be positive (m)")
+        self.control, self.task = control, task
+        self.safety_margin = float(safety_margin)
+        self.clearance_distance = float(clearance_distance)
+        self.weights = {
+            "time": float(time),
+            "collision": float(collision),
+            "clearance": float(clearance),
+        }
+        self.render_mode = render_mode
+        n_act = 2 if control == "both" else 1
+        self.action_space = spaces.Box(0.0, 1.0, (n_act,), np.float32)
+        lo, hi = observation_bounds()
+        self.observation_space = spaces.Box(lo, hi, dtype=np.float32)
+        self.world = DualArmWorld()
+        self._last_info: dict[str, Any] = {}
+
+    # ------------------------------------------------------------------ API
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = set(options) - set(OPTIONS)
+        if unknown:
+            raise ValueError(
+                f"unknown reset options {sorted(unknown)}; valid: {', '.join(OPTIONS)}"
+            )
+        mode = options.get("task", self.task)
+        if mode not in TASK_MODES:
+            raise ValueError(f"unknown task {mode!r}; choose one of {', '.join(TASK_MODES)}")
+        self.world.load(*task_module.sample_pair(self.np_random, mode, self.safety_margin))
+        self._wait2 = 0.0
+        info = self._info(collided=False, terms={k: 0.0 for k in self.weights})
+        return self.world.observation(), info
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        a1, a2 = self._parse(action)
+        w = self.world
+        done2_before = w.finished[1]
+        w.advance(a1, a2)
+        if not done2_before:
+            self._wait2 += (1.0 - a2) * DT
+        collided = w.distance <= self.safety_margin
+        d = w.distance
+        terms = {
+            "time": -self.weights["time"] * DT,
+            "collision": -self.weights["collision"] if collided else 0.0,
+            "clearance": -self.weights["clearance"] * max(0.0, 1.0 - d / self.clearance_distance),
+        }
+        reward = terms["time"] + terms["collision"] + terms["clearance"]
+        terminated = collided or all(w.finished)
+        return w.observation(), float(reward), bool(terminated), False, self._info(collided, terms)
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode != "rgb_array":
+            return None
+        return self.world.render()
+
+    def close(self) -> None:
+        self.world.close()
+
+    # ------------------------------------------------------------------ helpers
+
+    def _parse(self, action: Any) -> tuple[float, float]:
+        shape = self.action_space.shape
+        if isinstance(action, np.ndarray) and action.shape == shape:
+            a = action
+        else:
+            a = np.asarray(action, dtype=np.float64)
+            if a.shape != shape:
+                raise ValueError(
+                    f"action must have shape {shape} (control={self.control!r}), "
+                    f"got {np.shape(action)}"
+                )
+        values = [float(v) for v in a]
+        if any(v != v for v in values):
+            raise ValueError(f"action contains NaN: {a}")
+        values = [min(max(v, 0.0), 1.0) for v in values]
+        if self.control == "both":
+            return values[0], values[1]
+        return 1.0, values[0]
+
+    def _info(self, collided: bool, terms: dict[str, float]) -> dict[str, Any]:
+        w = self.world
+        done = all(w.finished)
+        info = {
+            "is_success": bool(done and not collided),
+            "cost": 1.0 if collided else 0.0,
+            "collision": bool(collided),
+            "distance": w.distance,
+            "makespan": w.elapsed,
+            "progress_1": float(w.progress[0]),
+            "progress_2": float(w.progress[1]),
+            "robot_2_wait": self._wait2,
+        }
+        for k, v in terms.items():
+            info[f"reward_{k}"] = float(v)
+        return info
+
+
+__all__ = ["CONTROLS", "OBS", "DualArmCellEnv"]

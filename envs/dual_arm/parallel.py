@@ -1,0 +1,92 @@
+"""PettingZoo ``ParallelEnv`` over the dual-arm cell: each robot times its own arm."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from motiongym.envs.dual_arm.env import OPTIONS, DualArmCellEnv
+
+AGENTS = ("robot_1", "robot_2")
+
+
+class DualArmParallelEnv(ParallelEnv):
+    """Agents ``robot_1`` and ``robot_2``, each choosing its own arm's advance.
+
+    The world, observation, reward and ``info`` are those of
+    :class:`~motiongym.envs.dual_arm.env.DualArmCellEnv` (``control="both"``):
+    both agents see the full observation (94,) and share the reward. Actions:
+    Box(0, 1, (1,)) per agent. All agents terminate together (both arms done
+    or a collision); truncated together after ``max_steps`` steps (no
+    ``TimeLimit`` wrapper in PettingZoo). Reset options other than ``task`` are
+    ignored (PettingZoo's API test passes arbitrary ones). Other keywords go to the Gymnasium
+    environment (``task``, ``safety_margin``, reward weights, ``render_mode``).
+    """
+
+    metadata = {
+        "name": "dual_arm_cell_v0",
+        "render_modes": ["rgb_array"],
+        "is_parallelizable": True,
+    }
+
+    def __init__(self, max_steps: int = 1000, **kwargs: Any) -> None:
+        if "control" in kwargs:
+            raise ValueError("control is fixed to 'both' in the parallel environment")
+        self._env = DualArmCellEnv(control="both", **kwargs)
+        self.max_steps = int(max_steps)
+        self.possible_agents = list(AGENTS)
+        self.agents: list[str] = []
+        self.render_mode = self._env.render_mode
+        self._steps = 0
+        self._action_space = spaces.Box(0.0, 1.0, (1,), np.float32)
+
+    def observation_space(self, agent: str) -> spaces.Box:
+        return self._env.observation_space
+
+    def action_space(self, agent: str) -> spaces.Box:
+        return self._action_space
+
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, dict]]:
+        # PettingZoo's API test resets with arbitrary options: pass on only ours.
+        ours = {k: v for k, v in (options or {}).items() if k in OPTIONS}
+        obs, info = self._env.reset(seed=seed, options=ours)
+        self.agents = list(AGENTS)
+        self._steps = 0
+        return {a: obs.copy() for a in self.agents}, {a: dict(info) for a in self.agents}
+
+    def step(self, actions: dict[str, Any]):
+        missing = set(self.agents) - set(actions)
+        if missing:
+            raise ValueError(f"missing actions for {sorted(missing)}; agents: {self.agents}")
+        a = [np.asarray(actions[name], dtype=np.float32).reshape(-1) for name in AGENTS]
+        for name, v in zip(AGENTS, a, strict=True):
+            if v.shape != (1,):
+                raise ValueError(f"action of {name} must have shape (1,), got {v.shape}")
+        obs, reward, terminated, _, info = self._env.step(np.concatenate(a))
+        self._steps += 1
+        truncated = not terminated and self._steps >= self.max_steps
+        agents = self.agents
+        out = (
+            {n: obs.copy() for n in agents},
+            {n: reward for n in agents},
+            {n: terminated for n in agents},
+            {n: truncated for n in agents},
+            {n: dict(info) for n in agents},
+        )
+        if terminated or truncated:
+            self.agents = []
+        return out
+
+    def render(self) -> np.ndarray | None:
+        return self._env.render()
+
+    def close(self) -> None:
+        self._env.close()
+
+    def state(self) -> np.ndarray:
+        return self._env.world.observation()

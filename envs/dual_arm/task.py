@@ -1,0 +1,244 @@
+"""Pick-and-place joint trajectories for the two arms, and how a pair is sampled.
+
+A task is a list of ``K = 4`` via configurations (start, pick, place, retreat)
+and the ``K - 1`` segment durations. Between vias the joints move on the
+straight joint-space segment with the quintic time law
+``s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5`` (rest to rest; peak ``ds/dtau =
+15/8``); a segment's duration is ``15/8 * max_j |dq_j| / v_max_j`` times a
+slowness factor >= 1, rounded up to whole 20 ms samples, so the joint speed
+limits ``V_MAX`` hold by construction and every via falls on a sample. The
+trajectory is sampled at ``DT = 20 ms`` (the paper's controller sample time).
+The compact form (vias and durations) is what the observation carries; the
+samples are reproducible from it (:meth:`Trajectory.from_compact`).
+
+Robot 2's path is also parametrised by travelled length (the paper's collision
+map axis): the Cartesian arc length of its wrist centre (paper: "the travelled
+length of robot 2's wrist"), ``L_T`` in total, split in ``N_l`` equal steps.
+
+Sampling (``sample_pair``, from the reset generator only): each arm's vias are
+drawn from joint boxes (``VIA_BOXES``, in its own base frame, so both arms
+reach into the shared middle of the cell) and redrawn if the gripper would
+dip under ``MIN_TOOL_Z``. Modes: ``"any"``; ``"colliding"``: the pair collides
+when both start together, and running them one after the other is collision
+free (robot 1's whole path clears robot 2's start, robot 2's whole path clears
+robot 1's end), so a finite start delay always exists; ``"paper"``: the fixed
+paper case (:func:`paper_case`), colliding undelayed over an interval like the
+paper's 0.76-1.16 s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motiongym.envs.dual_arm import model
+
+DT = 0.02  # s, controller sample time (paper)
+N_VIAS = 4
+V_MAX = np.array([2.0, 2.0, 2.0, 4.0, 4.0, 4.0])  # rad/s, our nominal joint speed limits
+PEAK = 15.0 / 8.0  # peak of ds/dtau for the quintic law
+MIN_TOOL_Z = 0.05  # m, the gripper tip stays above the floor
+TASK_MODES = ("colliding", "any", "paper")
+
+# Joint boxes (rad) per via, in the arm's own base frame: start, pick, place, retreat.
+VIA_BOXES = np.array(
+    [
+        [[-0.9, 0.9], [0.9, 1.5], [-1.6, -0.8], [-1.0, 1.0], [-1.0, 1.0], [-1.0, 1.0]],
+        [[-0.6, 0.6], [-0.3, 0.5], [-1.9, -0.9], [-1.0, 1.0], [-1.2, 1.2], [-1.0, 1.0]],
+        [[-1.2, 1.2], [-0.2, 0.6], [-2.0, -1.0], [-1.0, 1.0], [-1.2, 1.2], [-1.0, 1.0]],
+        [[-0.9, 0.9], [0.9, 1.5], [-1.6, -0.8], [-1.0, 1.0], [-1.0, 1.0], [-1.0, 1.0]],
+    ]
+)  # (4, 6, 2)
+SLOWNESS = (1.0, 1.6)  # range of the factor on each segment's minimum duration
+
+
+def quintic(tau: np.ndarray) -> np.ndarray:
+    """Rest-to-rest time law ``s(tau)``, tau in [0, 1]."""
+    tau = np.clip(tau, 0.0, 1.0)
+    return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """One arm's joint trajectory from its compact form.
+
+    Attributes:
+        vias: (K, 6) via configurations, rad.
+        durations: (K - 1,) segment durations, s (whole samples).
+        robot: 0 or 1 (which base frame).
+    """
+
+    vias: np.ndarray
+    durations: np.ndarray
+    robot: int
+
+    @staticmethod
+    def from_compact(vias: np.ndarray, durations: np.ndarray, robot: int) -> Trajectory:
+        vias = np.asarray(vias, float).reshape(N_VIAS, 6)
+        steps = np.maximum(np.round(np.asarray(durations, float) / DT), 1.0)
+        return Trajectory(vias, steps * DT, robot)
+
+    @property
+    def n_samples(self) -> int:
+        """N: index of the last sample (the trajectory has N + 1 samples)."""
+        return int(round(float(self.durations.sum()) / DT))
+
+    @property
+    def duration(self) -> float:
+        return self.n_samples * DT
+
+    def at_time(self, t: np.ndarray) -> np.ndarray:
+        """Joint angles at times ``t`` (...,) s -> (..., 6); clamped to [0, T]."""
+        t = np.asarray(t, float)
+        bounds = np.concatenate([[0.0], np.cumsum(self.durations)])  # (K,)
+        seg = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, N_VIAS - 2)
+        tau = (t - bounds[seg]) / self.durations[seg]
+        s = quintic(tau)[..., None]
+        return self.vias[seg] + s * (self.vias[seg + 1] - self.vias[seg])
+
+    def samples(self) -> np.ndarray:
+        """(N + 1, 6) joint angles at ``k * DT``."""
+        return self.at_time(np.arange(self.n_samples + 1) * DT)
+
+    def wrist_length(self, oversample: int = 8) -> tuple[np.ndarray, np.ndarray]:
+        """Wrist-centre arc length on a fine time grid: ``(times, lengths)``."""
+        t = np.linspace(0.0, self.duration, self.n_samples * oversample + 1)
+        w = model.wrist_centre(self.at_time(t), model.base_transform(self.robot))
+        step = np.linalg.norm(np.diff(w, axis=0), axis=1)
+        return t, np.concatenate([[0.0], np.cumsum(step)])
+
+    def length_parametrised(self, n_levels: int) -> tuple[np.ndarray, np.ndarray, float]:
+        """Configurations at travelled lengths ``l = s2 * L_T / N_l``.
+
+        Returns:
+            ``(q_levels (N_l + 1, 6), tlvst (N + 1,), L_T)``: the configuration at
+            each length level, and TLVST: the level index ``floor(l(k dt) / dl)``
+            the wrist has reached at each sample ``k`` (last sample = ``N_l``).
+        """
+        t, length = self.wrist_length()
+        total = float(length[-1])
+        # Strictly increasing in t so that the inverse is well defined at rests.
+        mono = length + 1e-12 * np.arange(len(length))
+        levels = np.linspace(0.0, mono[-1], n_levels + 1)
+        t_of_level = np.interp(levels, mono, t)
+        q_levels = self.at_time(t_of_level)
+        k_times = np.arange(self.n_samples + 1) * DT
+        l_k = np.interp(k_times, t, mono)
+        tl = np.floor(l_k / (mono[-1] / n_levels) + 1e-9).astype(np.int64)
+        tl = np.clip(tl, 0, n_levels)
+        tl[-1] = n_levels
+        return q_levels, tl, total
+
+    def compact(self) -> np.ndarray:
+        """Flat compact form: vias (K * 6) then durations (K - 1)."""
+        return np.concatenate([self.vias.ravel(), self.durations])
+
+
+def tool_tip_z(frames: np.ndarray) -> np.ndarray:
+    """Height of the gripper tip (...,) m from body frames (..., 6, 4, 4)."""
+    fr = frames[..., 5, :, :]
+    return fr[..., 2, 3] + fr[..., 2, 2] * model.LINKS[5][1][2]
+
+
+def _arm_geometry(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Tip heights (N + 1,) and capsule end points (N + 1, 5, 3) x 2 at the samples."""
+    frames = model.body_frames(traj.samples(), model.base_transform(traj.robot))
+    return (tool_tip_z(frames), *model.segments_from_frames(frames))
+
+
+def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, tuple]:
+    while True:
+        lo, hi = VIA_BOXES[..., 0], VIA_BOXES[..., 1]
+        vias = rng.uniform(lo, hi)  # (K, 6)
+        dq = np.abs(np.diff(vias, axis=0))  # (K-1, 6)
+        minimum = PEAK * np.max(dq / V_MAX, axis=1)
+        dur = minimum * rng.uniform(*SLOWNESS, size=N_VIAS - 1)
+        dur = np.ceil(np.maximum(dur, 0.2) / DT) * DT
+        traj = Trajectory(vias, dur, robot)
+        tip, a, b = _arm_geometry(traj)
+        if tip.min() >= MIN_TOOL_Z:
+            return traj, (a, b)
+
+
+def _check_pair(seg1: tuple, seg2: tuple, margin: float) -> tuple[bool, bool]:
+    """(collides when both start together, one after the other is collision free).
+
+    One after the other: robot 1's whole path clears robot 2's start and robot
+    2's whole path clears robot 1's end.
+    """
+    (a1, b1), (a2, b2) = seg1, seg2
+    n1, n2 = len(a1) - 1, len(a2) - 1
+    k = np.arange(max(n1, n2) + 1)
+    i1 = np.concatenate([np.minimum(k, n1), np.arange(n1 + 1), np.full(n2 + 1, n1)])
+    i2 = np.concatenate([np.minimum(k, n2), np.zeros(n1 + 1, int), np.arange(n2 + 1)])
+    hit = model.segments_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin)
+    return bool(hit[: len(k)].any()), not bool(hit[len(k) :].any())
+
+
+def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
+    """``d(R1, R2)`` over time when both start together, (max(N1, N2) + 1,)."""
+    n = max(traj1.n_samples, traj2.n_samples)
+    t = np.arange(n + 1) * DT
+    return model.robot_distance(traj1.at_time(t), traj2.at_time(t))
+
+
+def sequential_clear(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> bool:
+    """Robot 1's path clears robot 2's start and robot 2's path clears robot 1's end."""
+    seg = [_arm_geometry(t)[1:] for t in (traj1, traj2)]
+    return _check_pair(seg[0], seg[1], margin)[1]
+
+
+def sample_pair(
+    rng: np.random.Generator, mode: str = "colliding", margin: float = 0.0, max_tries: int = 1000
+) -> tuple[Trajectory, Trajectory]:
+    """A pair of tasks (robot 1, robot 2) drawn from ``rng``; see the module doc."""
+    if mode not in TASK_MODES:
+        raise ValueError(f"unknown task mode {mode!r}; choose one of {', '.join(TASK_MODES)}")
+    if mode == "paper":
+        return paper_case()
+    for _ in range(max_tries):
+        (t1, s1), (t2, s2) = _sample_arm(rng, 0), _sample_arm(rng, 1)
+        if mode == "any":
+            return t1, t2
+        collides, sequential_ok = _check_pair(s1, s2, margin)
+        if collides and sequential_ok:
+            return t1, t2
+    raise RuntimeError(f"no colliding pair found in {max_tries} tries")
+
+
+# The paper's Fig. 6 trajectories are not in the text: our own pick-and-place pair
+# in which both arms reach into the middle of the cell around t = 1 s.
+_PAPER_VIAS = (
+    np.array(
+        [
+            [0.0, 1.0, -0.8, 0.0, 0.5, 0.0],
+            [0.2, 0.05, -1.35, 0.0, 0.6, 0.0],
+            [0.9, 0.3, -1.5, 0.3, 0.4, 0.0],
+            [1.4, 1.0, -0.7, 0.0, 0.5, 0.0],
+        ]
+    ),
+    np.array(
+        [
+            [-0.6, 1.0, -0.8, 0.0, 0.5, 0.0],
+            [0.05, 0.1, -1.3, 0.0, 0.5, 0.0],
+            [0.6, 0.2, -1.4, 0.2, 0.5, 0.0],
+            [0.5, 1.0, -0.8, 0.0, 0.5, 0.0],
+        ]
+    ),
+)
+# Minimum durations of the quintic law under V_MAX, rounded up to whole samples.
+_PAPER_DURATIONS = (np.array([0.9, 0.66, 0.76]), np.array([0.86, 0.52, 0.76]))
+
+
+def paper_case() -> tuple[Trajectory, Trajectory]:
+    """The fixed "paper case" pair (robot 1, robot 2)."""
+    return tuple(Trajectory.from_compact(_PAPER_VIAS[r], _PAPER_DURATIONS[r], r) for r in range(2))  # type: ignore[return-value]
+
+
+def speeds_ok(traj: Trajectory) -> bool:
+    """True if no joint exceeds ``V_MAX`` (finite differences on a fine grid)."""
+    t = np.linspace(0.0, traj.duration, traj.n_samples * 10 + 1)
+    q = traj.at_time(t)
+    v = np.abs(np.diff(q, axis=0)) / np.diff(t)[:, None]
+    return bool(np.all(v <= V_MAX * (1 + 1e-6)))
