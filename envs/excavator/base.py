@@ -1,0 +1,350 @@
+"""The machine in the world: what both excavator environments share.
+
+One step (``dt`` s) of the hydraulic machine:
+
+1. action ``a`` (4,) in [-1, 1] -> commanded joint rates ``a * rate_max``;
+2. in soil (carving worlds), rates scaled by the resistance model
+   (:func:`motiongym.envs.excavator.soil.speed_fraction` at the tip's depth);
+3. joint angles integrated and held inside the joint ranges (the rate of a
+   joint at its stop is zero);
+4. forward kinematics (:func:`arm_points`, the scalar form of eq. 4);
+5. carving (the cutting edge sweeps the height map, soil into the bucket)
+   and pouring: the bucket opening faces ``n = (sin beta, -cos beta)`` in the
+   boom plane (radial, up); when ``n_z < -0.3`` (opening turned more than
+   about 17 deg below horizontal) the soil pours out at ``capacity / 1 s``,
+   into the truck if the bucket is over its body, else spilled on the ground;
+6. clearances to the pipe and the truck (:mod:`.obstacles`).
+
+Subclasses (the tasks) supply ``TASK``, scene sampling, reward and success.
+The scalar state lives in Python floats: the step makes few NumPy calls
+(an environment step costs tens of microseconds).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from motiongym.envs.excavator import observation as obs_layout
+from motiongym.envs.excavator.config import Machine, machine_from_kwargs
+from motiongym.envs.excavator.kinematics import arm_points
+from motiongym.envs.excavator.obstacles import Pipe, Truck, pipe_clearance, truck_clearance
+from motiongym.envs.excavator.soil import Terrain, speed_fraction
+from motiongym.envs.excavator.task import GRID_CELL, GRID_ORIGIN, GRID_SHAPE, Scene
+
+POUR_NZ = -0.3  # opening normal z below which soil pours
+POUR_TIME = 1.0  # s to empty a full bucket
+HORIZON = 1.0  # m: exact clearances below this bound
+RESET_OPTIONS = ("q0",)
+PROFILE_BINS_PER_DEG = 10
+
+
+@functools.lru_cache(maxsize=8)
+def profile_table(L0: float, d2: float) -> np.ndarray:
+    """Flat map indices of the profile samples per 0.1 deg of swing, (3600, 24).
+
+    The samples lie on the boom plane (offset ``d2``) at the radii of
+    :data:`observation.PROFILE_RADII` from the swing axis (at ``x = -L0``);
+    they stay inside the map (radii <= 10.2 m, map +-11 m).
+    """
+    angles = np.radians(np.arange(360 * PROFILE_BINS_PER_DEG) / PROFILE_BINS_PER_DEG)[:, None]
+    r = obs_layout.PROFILE_RADII[None, :]
+    x = -L0 + np.cos(angles) * r + np.sin(angles) * d2
+    y = np.sin(angles) * r - np.cos(angles) * d2
+    i = np.clip(((x - GRID_ORIGIN[0]) / GRID_CELL).astype(np.intp), 0, GRID_SHAPE[0] - 1)
+    j = np.clip(((y - GRID_ORIGIN[1]) / GRID_CELL).astype(np.intp), 0, GRID_SHAPE[1] - 1)
+    return i * GRID_SHAPE[1] + j
+
+
+class ExcavatorBase(gym.Env):
+    """Shared machinery; see :class:`ExcavatorReachEnv` and :class:`ExcavatorEnv`."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+    TASK = "reach"
+    CARVE = False
+    REWARD_TERMS: tuple[str, ...] = ()
+
+    def __init__(
+        self,
+        machine: dict | Machine | None = None,
+        dt: float = 0.1,  # s
+        pipe_safety: float = 0.5,  # m
+        render_mode: str | None = None,
+        render_size: tuple[int, int] = (480, 640),
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"unknown render_mode {render_mode!r}; valid: {self.metadata['render_modes']}"
+            )
+        if not dt > 0:
+            raise ValueError(f"dt must be positive, got {dt!r}")
+        self.m = machine_from_kwargs(machine)
+        self.dt = float(dt)
+        self.pipe_safety = float(pipe_safety)
+        self.render_mode = render_mode
+        self.render_size = tuple(render_size)
+        self.layout = obs_layout.layout(self.TASK)
+        low, high = obs_layout.bounds(self.TASK, self.m)
+        self.observation_space = spaces.Box(low, high, dtype=np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
+        self._low64 = low.astype(np.float64)
+        self._high64 = high.astype(np.float64)
+        self._renderer = None
+        self.scene: Scene | None = None
+
+    # ----------------------------------------------------------------- hooks
+    def _sample_scene(self, rng: np.random.Generator) -> Scene:
+        raise NotImplementedError
+
+    def _task_reset(self) -> None:
+        """Set per-episode task state after the scene is in place."""
+
+    def _task_step(self) -> tuple[dict[str, float], bool, dict[str, Any]]:
+        """``(reward terms, success, extra info)`` after the physics of a step."""
+        raise NotImplementedError
+
+    def _task_obs(self, buf: np.ndarray) -> None:
+        """Write the task's slices of the observation into ``buf``."""
+
+    # ----------------------------------------------------------------- reset
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        options = dict(options or {})
+        unknown = sorted(set(options) - set(RESET_OPTIONS))
+        if unknown:
+            raise ValueError(f"unknown reset option(s) {unknown}; valid: {list(RESET_OPTIONS)}")
+        scene = self._sample_scene(self.np_random)
+        self.scene = scene
+        self.terrain = Terrain(scene.heights, GRID_ORIGIN, GRID_CELL)
+        self.pipe: Pipe = scene.pipe
+        self.truck: Truck = scene.truck
+        q0 = options.get("q0", self.m.q_ready)
+        q0 = np.asarray(q0, dtype=np.float64)
+        if q0.shape != (4,) or not np.all(np.isfinite(q0)):
+            raise ValueError(f"option q0 must be 4 finite joint angles, got {options.get('q0')!r}")
+        self.q = np.clip(q0, self.m.q_min, self.m.q_max).tolist()
+        self.qdot = [0.0, 0.0, 0.0, 0.0]
+        self.fill = 0.0
+        self.truck_soil = 0.0
+        self.spill = 0.0
+        self.elapsed = 0.0
+        self.steps = 0
+        a, b = self.pipe.a, self.pipe.b
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        if length > 1e-9:
+            self._pipe_line = (
+                (a[0], a[1]),
+                ((b[0] - a[0]) / length, (b[1] - a[1]) / length),
+                length,
+            )
+        else:  # a vertical or point pipe: no plan-view bound
+            self._pipe_line = ((a[0], a[1]), (0.0, 0.0), 0.0)
+        self._pipe_zmax = max(a[2], b[2])
+        self._truck_edges = self.truck.edges()
+        self._truck_corners = [tuple(c) for c in self._truck_edges[0][:4, :2].tolist()]
+        self._radii = np.array(self.m.link_radius)
+        self._max_r = max(self.m.link_radius)
+        self._profile_key = None
+        self._profile_table = profile_table(self.m.L0, self.m.d2)
+        self._flat_heights = self.terrain.h.reshape(-1)  # a view, follows the carving
+        self._obs = np.zeros(self.observation_space.shape, dtype=np.float64)
+        self._obs[self.layout["truck"]] = self.truck.as_array()
+        self._obs[self.layout["pipe"]] = self.pipe.as_array()
+        self._forward()
+        self._prev_edge = self._edge()
+        self._prev_tip_z = self.tip[2]
+        self._clearances()
+        self._task_reset()
+        info = self._info(dict.fromkeys(self.REWARD_TERMS, 0.0), False)
+        return self._observation(), info
+
+    # ------------------------------------------------------------------ step
+    def step(self, action):
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (4,):
+            raise ValueError(
+                f"action must have shape (4,) (swing, boom, stick, bucket), got {a.shape}"
+            )
+        if not np.isfinite(a).all():
+            raise ValueError(f"action must be finite, got {a.tolist()}")
+        if self.scene is None:
+            raise RuntimeError("call reset() before step()")
+        m, dt = self.m, self.dt
+        scale = 1.0
+        if self.CARVE:
+            depth = self._ground_at_tip - self.tip[2]
+            if depth > 0.0:
+                scale = speed_fraction(depth, m.bucket_width, m)
+        q, qdot = self.q, self.qdot
+        for k, v in enumerate(a.tolist()):
+            rate = (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * m.rate_max[k] * scale
+            new = q[k] + rate * dt
+            lo, hi = m.q_min[k], m.q_max[k]
+            if new < lo or new > hi:
+                new = lo if new < lo else hi
+                rate = (new - q[k]) / dt
+            q[k] = new
+            qdot[k] = rate
+        self._forward()
+        self.steps += 1
+        self.elapsed = self.steps * dt
+        if self.CARVE:
+            self._carve_and_pour()
+        self._clearances()
+        terms, success, extra = self._task_step()
+        reward = float(sum(terms.values()))
+        contact = self.pipe_clear <= 0.0 or self.truck_clear <= 0.0
+        terminated = bool(success or contact)
+        info = self._info(terms, success)
+        info.update(extra)
+        return self._observation(), reward, terminated, False, info
+
+    # --------------------------------------------------------------- physics
+    def _forward(self) -> None:
+        self.points = arm_points(*self.q, self.m)
+        self.tip = self.points[3]
+        self.beta = self.q[1] + self.q[2] + self.q[3]
+        self._ground_at_tip = self.terrain.height_at(self.tip[0], self.tip[1])
+
+    def _edge(self) -> tuple[np.ndarray, np.ndarray]:
+        half = 0.5 * self.m.bucket_width
+        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
+        x, y = self.tip[0], self.tip[1]
+        return np.array([x + half * s1, y - half * c1]), np.array([x - half * s1, y + half * c1])
+
+    def _carve_and_pour(self) -> None:
+        m = self.m
+        z = self.tip[2]
+        top = self.terrain.max_height
+        edge = self._edge()
+        if z < top or self._prev_tip_z < top:
+            free = m.bucket_capacity - self.fill
+            self.fill += self.terrain.carve(self._prev_edge, edge, self._prev_tip_z, z, free)
+            self._ground_at_tip = self.terrain.height_at(self.tip[0], self.tip[1])
+        self._prev_edge = edge
+        self._prev_tip_z = z
+        if self.fill > 0.0 and -math.cos(self.beta) < POUR_NZ:
+            amount = min(self.fill, m.bucket_capacity * self.dt / POUR_TIME)
+            self.fill -= amount
+            pin = self.points[2]
+            x, y = 0.5 * (pin[0] + self.tip[0]), 0.5 * (pin[1] + self.tip[1])
+            if self.truck.contains_xy(x, y) and min(pin[2], self.tip[2]) > self.truck.height:
+                self.truck_soil += amount
+            else:
+                self.spill += amount
+                self.terrain.deposit(x, y, amount)
+
+    def _clearances(self) -> None:
+        """Pipe and truck clearance: cheap lower bounds first, exact when under HORIZON.
+
+        Every arm point lies on the vertical half-plane at azimuth ``q1``
+        (lateral offset ``-d2``), between radii ``rmin`` and ``rmax`` and above
+        height ``lowest``. Pipe: horizontal gap from that radial segment to the
+        pipe's (infinite) line in plan, vertical gap to the pipe's top; the
+        distance is at least their Euclidean combination. Truck: lateral gap
+        of the footprint's corners to the boom plane (all on one side), or the
+        radial gap between the arm and the footprint's corners (a projection
+        is 1-Lipschitz and a box's projection spans its corners'), or the
+        height above the rim.
+        """
+        pts = self.points
+        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
+        ox, oy = -self.m.L0 + s1 * self.m.d2, -c1 * self.m.d2  # the plane's origin in plan
+        radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
+        rmin, rmax = min(radial), max(radial)
+        lowest = min(pts[1][2], pts[2][2], pts[3][2])
+        # Pipe.
+        (px, py), (ux, uy), plen = self._pipe_line
+        gaps = []
+        for r in (rmin, rmax):
+            gaps.append((ox + c1 * r - px) * -uy + (oy + s1 * r - py) * ux)
+        horizontal = 0.0 if gaps[0] * gaps[1] <= 0.0 else min(abs(gaps[0]), abs(gaps[1]))
+        vertical = max(lowest - self._pipe_zmax, 0.0)
+        bound = math.hypot(horizontal, vertical) - self._max_r - self.pipe.radius
+        if bound < HORIZON:
+            starts, ends = np.array(pts[:3]), np.array(pts[1:])
+            self.pipe_clear = pipe_clearance(starts, ends, self._radii, self.pipe)
+        else:
+            self.pipe_clear = bound
+        # Truck.
+        lateral = [-s1 * (x - ox) + c1 * (y - oy) for x, y in self._truck_corners]
+        side = 0.0 if min(lateral) * max(lateral) <= 0.0 else min(map(abs, lateral))
+        along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
+        ahead = max(min(along) - rmax, rmin - max(along), 0.0)
+        bound = max(side, ahead, lowest - self.truck.height) - self._max_r
+        if bound < HORIZON:
+            starts, ends = np.array(pts[:3]), np.array(pts[1:])
+            self.truck_clear = truck_clearance(
+                starts, ends, self._radii, self.truck, self._truck_edges
+            )
+        else:
+            self.truck_clear = bound
+
+    # ----------------------------------------------------------- observation
+    def _profile(self) -> np.ndarray:
+        """Ground heights along the boom plane, at the nearest 0.1 deg of swing."""
+        key = (self.q[0], self.terrain.version)
+        if key != self._profile_key:
+            b = (
+                int(round(math.degrees(self.q[0]) * PROFILE_BINS_PER_DEG))
+                % self._profile_table.shape[0]
+            )
+            self._profile_cache = self._flat_heights[self._profile_table[b]]
+            self._profile_key = key
+        return self._profile_cache
+
+    def _observation(self) -> np.ndarray:
+        buf = self._obs
+        buf[0:4] = self.q
+        buf[4:8] = self.qdot
+        buf[8:11] = self.tip
+        buf[11] = self.beta
+        buf[12] = self.fill
+        buf[13:37] = self._profile()
+        self._task_obs(buf)
+        return buf.astype(np.float32)  # inside the bounds by construction (tested)
+
+    def _info(self, terms: dict[str, float], success: bool) -> dict[str, Any]:
+        cost = (
+            self.pipe_clear < self.pipe_safety or self.pipe_clear <= 0.0 or self.truck_clear <= 0.0
+        )
+        info = {f"reward_{k}": float(v) for k, v in terms.items()}
+        info.update(
+            is_success=bool(success),
+            cost=1.0 if cost else 0.0,
+            pipe_clearance=float(self.pipe_clear),
+            truck_clearance=float(self.truck_clear),
+            pipe_contact=float(self.pipe_clear <= 0.0),
+            truck_contact=float(self.truck_clear <= 0.0),
+            bucket_fill=float(self.fill),
+            truck_soil=float(self.truck_soil),
+            spill=float(self.spill),
+            elapsed=float(self.elapsed),
+        )
+        return info
+
+    # ---------------------------------------------------------------- render
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
+            return None
+        if self._renderer is None:
+            from motiongym.envs.excavator.model import SceneRenderer
+
+            self._renderer = SceneRenderer(self.m, self.render_size)
+        return self._renderer.render(self)
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        state["_renderer"] = None
+        return state
