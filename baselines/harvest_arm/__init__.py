@@ -9,6 +9,9 @@ from __future__ import annotations
 
 _POLICIES = {
     "potential-field": "motiongym.baselines.harvest_arm.policy:PotentialFieldPolicy",
+    "potential-field-extended": (
+        "motiongym.baselines.harvest_arm.policy:ExtendedPotentialFieldPolicy"
+    ),
     "resolved-rate": "motiongym.baselines.harvest_arm.policy:ResolvedRatePolicy",
 }
 

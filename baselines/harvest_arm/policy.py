@@ -78,6 +78,8 @@ class _ArmPolicy(ScriptedPolicy):
 class PotentialFieldPolicy(_ArmPolicy):
     """The paper's method: potential-field path, reference velocities, eq. 1."""
 
+    interior_only = True  # the paper's applicability tests of eq. 9-10
+
     def new_memory(self) -> dict[str, Any]:
         return {"path": None, "index": 0}
 
@@ -142,11 +144,20 @@ class PotentialFieldPolicy(_ArmPolicy):
         sphere = mask & ~o["is_bar"]
         bar = mask & o["is_bar"]
         w_d = trajectory_following(points, v)
-        w_ob = point_obstacle_terms(points, o["a"][sphere], o["radius"][sphere], self.link_radius)
+        r, interior = self.link_radius, self.interior_only
+        w_ob = point_obstacle_terms(
+            points, o["a"][sphere], o["radius"][sphere], r, interior_only=interior
+        )
         w_ob += bar_obstacle_terms(
-            points, o["a"][bar], o["b"][bar], o["radius"][bar], self.link_radius
+            points, o["a"][bar], o["b"][bar], o["radius"][bar], r, interior_only=interior
         )
         return combine(w_d, w_ob, GRIPPER_SPEED)
+
+
+class ExtendedPotentialFieldPolicy(PotentialFieldPolicy):
+    """The paper's method with eq. 9-10 also acting beyond the links' ends (our extension)."""
+
+    interior_only = False
 
 
 class ResolvedRatePolicy(_ArmPolicy):

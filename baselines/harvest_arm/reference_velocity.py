@@ -77,8 +77,14 @@ def point_obstacle_terms(
     radius: np.ndarray,
     link_radius: float = 0.0,
     params: FieldParameters = AVOIDANCE,
+    interior_only: bool = True,
 ) -> np.ndarray:
-    """Eq. 9 terms ``w_ob`` of sphere obstacles (K, dim), summed per point: (P, dim)."""
+    """Eq. 9 terms ``w_ob`` of sphere obstacles (K, dim), summed per point: (P, dim).
+
+    ``interior_only=False`` also acts on obstacles beyond the link's ends,
+    with the distance and direction to the link's closest point (an
+    extension; the paper's test is ``0 <= C.U <= |U|^2``).
+    """
     if len(centres) == 0:
         return np.zeros_like(points)
     U, length, u = _links(points)
@@ -87,7 +93,14 @@ def point_obstacle_terms(
     perp = C - np.einsum("lkd,ld->lk", C, u)[..., None] * u[:, None, :]  # (L, K, dim)
     dist = np.linalg.norm(perp, axis=-1)  # distance to the link's line
     rho = dist - radius[None, :] - link_radius
-    inside = (along >= 0.0) & (along <= length[:, None] ** 2) & (rho < params.rho0)
+    inside = (along >= 0.0) & (along <= length[:, None] ** 2)
+    if not interior_only:
+        t = np.clip(along / np.maximum(length[:, None] ** 2, _EPS), 0.0, 1.0)  # (L, K)
+        perp = C - t[..., None] * U[:, None, :]  # to the closest point of the segment
+        dist = np.linalg.norm(perp, axis=-1)
+        rho = dist - radius[None, :] - link_radius
+        inside = np.ones_like(inside)
+    inside &= rho < params.rho0
     mag = np.where(inside, obstacle_magnitude(rho, params), 0.0)  # (L, K)
     away = -perp / np.maximum(dist, _EPS)[..., None]  # ((C x u) x u) normalised
     return _to_points((mag[..., None] * away).sum(axis=1))
@@ -100,8 +113,13 @@ def bar_obstacle_terms(
     radius: np.ndarray,
     link_radius: float = 0.0,
     params: FieldParameters = AVOIDANCE,
+    interior_only: bool = True,
 ) -> np.ndarray:
-    """Eq. 10 terms ``w_obl`` of bar obstacles ``a``-``b`` (K, dim), per point: (P, dim)."""
+    """Eq. 10 terms ``w_obl`` of bar obstacles ``a``-``b`` (K, dim), per point: (P, dim).
+
+    ``interior_only=False`` also acts when a closest point is a segment's
+    end (an extension of the paper's applicability test).
+    """
     if len(a) == 0:
         return np.zeros_like(points)
     p0, p1 = points[:-1, None, :], points[1:, None, :]  # (L, 1, dim)
@@ -112,6 +130,8 @@ def bar_obstacle_terms(
     t = np.einsum("lkd,lkd->lk", on_bar - a[None], np.broadcast_to(d2, on_bar.shape))
     t = t / np.maximum(np.sum(d2 * d2, axis=-1), _EPS)
     interior = (s > 1e-9) & (s < 1 - 1e-9) & (t > 1e-9) & (t < 1 - 1e-9)
+    if not interior_only:
+        interior = np.ones_like(interior)
     rho = dist - radius[None, :] - link_radius
     mag = np.where(interior & (rho < params.rho0), obstacle_magnitude(rho, params), 0.0)
     away = (on_link - on_bar) / np.maximum(dist, _EPS)[..., None]  # common normal, off the bar

@@ -238,6 +238,8 @@ def build_model(
         for obstacle in obstacle_geoms:
             s.add_pair(geomname1=link, geomname2=obstacle, margin=5.0)
     model = s.compile()
+    for name in obstacle_geoms:  # moved and turned at reset: never assume the body's frame
+        model.geom_sameframe[model.geom(name).id] = mujoco.mjtSameFrame.mjSAMEFRAME_NONE
     index = {
         "link_geoms": np.array([model.geom(g).id for g in link_geoms]),
         "obstacle_geoms": np.array([model.geom(g).id for g in obstacle_geoms], dtype=int),

@@ -1,0 +1,189 @@
+"""The harvest-arm world: arms, Jacobians, clearances, scenes, env conventions."""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import gymnasium as gym  # noqa: E402
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from stable_baselines3.common.env_checker import check_env as sb3_check_env  # noqa: E402
+
+import motiongym  # noqa: E402, F401
+from motiongym.envs.geometry import closest_points_between_segments  # noqa: E402
+from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec  # noqa: E402
+from motiongym.envs.harvest_arm.task import (  # noqa: E402
+    START_CLEARANCE,
+    clearance_to_arm,
+    solve_ik,
+)
+
+ARMS = [(True, 3), (True, 4), (True, 5), (False, 5), (False, 6), (False, 7)]
+
+
+def _make(planar: bool, dof: int, **kwargs) -> gym.Env:
+    env_id = "motiongym/HarvestArmPlanar-v0" if planar else "motiongym/HarvestArm-v0"
+    return gym.make(env_id, dof=dof, **kwargs)
+
+
+@pytest.mark.parametrize(("planar", "dof"), ARMS)
+def test_every_arm_passes_the_gymnasium_and_sb3_checkers(planar, dof):
+    env = _make(planar, dof)
+    check_env(env.unwrapped, skip_render_check=True)
+    sb3_check_env(_make(planar, dof), warn=True)
+    observation, _ = env.reset(seed=0)
+    assert observation.shape == (env.unwrapped.layout.size,)
+
+
+def test_a465_table_3_ranges_and_speeds():
+    spec = arm_spec(5, planar=False)
+    np.testing.assert_allclose(np.rad2deg(spec.limits), [175, 90, 110, 180, 105])
+    np.testing.assert_allclose(spec.speeds, [3.14, 3.14, 3.14, 2.99, 3.02])
+    kin = ArmKinematics(spec)
+    points = kin.forward(np.zeros(5))  # stretched straight up
+    np.testing.assert_allclose(points[-1], [0, 0, 0.3302 + 0.3048 + 0.3302 + 0.226], atol=1e-12)
+
+
+@pytest.mark.parametrize(("planar", "dof"), ARMS)
+def test_point_jacobians_match_finite_differences(planar, dof):
+    spec = arm_spec(dof, planar)
+    kin = ArmKinematics(spec)
+    rng = np.random.default_rng(dof)
+    for _ in range(3):
+        q = rng.uniform(-0.8, 0.8, dof) * spec.limits
+        _, jac = kin.jacobians(q)  # (P, dim, n)
+        numeric = np.zeros_like(jac)
+        for j in range(dof):
+            dq = np.zeros(dof)
+            dq[j] = 1e-6
+            numeric[:, :, j] = (kin.forward(q + dq) - kin.forward(q - dq)) / 2e-6
+        np.testing.assert_allclose(jac, numeric, atol=1e-8)
+
+
+def test_clearances_match_numpy_geometry_and_mj_geom_distance():
+    env = _make(False, 7).unwrapped
+    rng = np.random.default_rng(0)
+    for seed in range(3):
+        observation, _ = env.reset(seed=seed, options={"q": rng.uniform(-1, 1, 7)})
+        o = env.layout.parse(observation)
+        scene = env.scene
+        points = o["points"]
+        dist, _, _ = closest_points_between_segments(
+            points[:-1, None], points[1:, None], o["a"][None], o["b"][None]
+        )
+        expected = np.minimum(dist - env.link_radius - o["radius"][None], 1.0)  # (L, K)
+        np.testing.assert_allclose(o["distances"], expected, atol=1e-6)
+        assert scene.is_bar.sum() == 3
+        fromto = np.zeros(6)
+        for li, lg in enumerate(env.index["link_geoms"]):
+            for k, og in enumerate(env.index["obstacle_geoms"]):
+                d = mujoco.mj_geomDistance(env.model, env.data, lg, og, 10.0, fromto)
+                assert min(d, 1.0) == pytest.approx(expected[li, k], abs=1e-6)
+
+
+def test_planar_clearance_of_a_known_case():
+    env = _make(True, 3).unwrapped
+    length = 0.861 / 3
+    # arm stretched along +x; a 0.02 m sphere 0.1 m above the middle of link 2
+    centre = [1.5 * length, 0.1]
+    observation, info = env.reset(
+        options={
+            "q": np.zeros(3),
+            "fruit": [0.5, -0.3],
+            "obstacles": [{"center": centre, "radius": 0.02}],
+        }
+    )
+    assert info["min_distance"] == pytest.approx(0.1 - 0.02 - 0.02, abs=1e-9)
+    o = env.layout.parse(observation)
+    assert o["mask"].sum() == 1
+    assert o["distances"][1, 0] == pytest.approx(0.06, abs=1e-6)
+    assert (o["distances"][:, 1:] == 1.0).all()  # empty slots read the clip value
+
+
+@pytest.mark.parametrize(("planar", "dof"), ARMS)
+def test_scenes_are_reachable_and_clear_of_the_start_pose(planar, dof):
+    env = _make(planar, dof).unwrapped
+    for seed in range(3):
+        env.reset(seed=seed)
+        scene = env.scene
+        assert len(scene) == (8 if planar else 10)
+        assert scene.is_bar.sum() == (0 if planar else 3)
+        kin = env.kinematics
+        start = kin.forward(np.array(kin.spec.home))
+        assert clearance_to_arm(start, env.link_radius, scene).min() >= START_CLEARANCE
+        assert solve_ik(kin, scene.fruit, np.array(kin.spec.home))[1] < 2e-3
+
+
+def test_reward_terms_sum_and_info_keys():
+    env = _make(False, 5)
+    env.reset(seed=2)
+    env.action_space.seed(2)
+    for _ in range(20):
+        _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        terms = {k: v for k, v in info.items() if k.startswith("reward_")}
+        assert set(terms) == {
+            f"reward_{t}" for t in ("progress", "clearance", "collision", "effort", "success")
+        }
+        assert sum(terms.values()) == pytest.approx(reward)
+        assert info["cost"] == float(info["min_distance"] < 0.03 or info["collision"])
+        assert info["min_distance_so_far"] <= info["min_distance"]
+        if terminated or truncated:
+            break
+
+
+def test_arriving_at_the_fruit_terminates_with_success():
+    env = _make(True, 3).unwrapped
+    kin = env.kinematics
+    q_goal, _ = solve_ik(kin, np.array([0.5, -0.3]), np.array(kin.spec.home))
+    fruit = kin.forward(q_goal)[-1]
+    env.reset(options={"q": q_goal, "fruit": fruit, "obstacles": []})
+    _, reward, terminated, _, info = env.step(np.zeros(3, np.float32))
+    assert terminated and info["is_success"]
+    assert info["reward_success"] == pytest.approx(10.0)
+
+
+def test_same_seed_same_scene_and_trajectory():
+    a, b = _make(False, 6), _make(False, 6)
+    oa, _ = a.reset(seed=11)
+    ob, _ = b.reset(seed=11)
+    np.testing.assert_array_equal(oa, ob)
+    action = np.linspace(-1, 1, 6).astype(np.float32)
+    for _ in range(5):
+        np.testing.assert_array_equal(a.step(action)[0], b.step(action)[0])
+
+
+def test_bad_input_is_rejected_with_the_valid_choices():
+    with pytest.raises(ValueError, match=r"\(5, 6, 7\)"):
+        _make(False, 4)
+    with pytest.raises(ValueError, match=r"\(3, 4, 5\)"):
+        _make(True, 7)
+    env = _make(True, 3)
+    with pytest.raises(ValueError, match="valid"):
+        env.reset(options={"start": 1})
+    with pytest.raises(ValueError, match="together"):
+        env.reset(options={"fruit": [0.5, 0.0]})
+    with pytest.raises(ValueError, match="keys"):
+        env.reset(options={"fruit": [0.5, 0.0], "obstacles": [{"centre": [0, 0], "radius": 1}]})
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(4))
+    with pytest.raises(ValueError, match="finite"):
+        env.step(np.array([np.nan, 0, 0]))
+
+
+def test_render_rgb_array_shows_the_scene():
+    env = _make(False, 7, render_mode="rgb_array", width=160, height=120)
+    env.reset(seed=0)
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    try:
+        frame = env.render()
+    except Exception as error:  # pragma: no cover - machines without EGL
+        pytest.skip(f"offscreen rendering unavailable: {error}")
+    assert frame.shape == (120, 160, 3)
+    assert frame.std() > 5
+    env.close()
