@@ -12,7 +12,7 @@ of that class (Caterpillar 320 / Komatsu PC210 / Volvo EC220 brochures):
   (``L1``), swing axis on the track centre (``L0 = 0``), boom centred (``d2 = 0``);
   this gives a maximum ground-level reach of about 10.2 m and a maximum
   digging depth of about 6.7 m, the spec-sheet values of the class;
-* joint ranges chosen to reproduce those envelopes (boom -50 deg to +60 deg
+* joint ranges chosen to reproduce those envelopes (boom -50 deg to +69 deg
   from horizontal, stick folded 30 deg to 155 deg under the boom, bucket
   rotation about 190 deg);
 * hydraulic joint-rate limits: swing 11 rpm (1.15 rad/s, spec sheets give
@@ -53,7 +53,7 @@ class Machine:
     L4: float = 1.5  # bucket pin to cutting edge (m)
     # Joint limits (theta1 swing, theta2 boom, theta3 stick, theta4 bucket).
     q_min: tuple[float, float, float, float] = (-math.pi, -0.87, -2.7, -2.3)
-    q_max: tuple[float, float, float, float] = (math.pi, 1.05, -0.52, 0.9)
+    q_max: tuple[float, float, float, float] = (math.pi, 1.2, -0.52, 0.9)
     rate_max: tuple[float, float, float, float] = (1.15, 0.6, 0.7, 1.0)
     # Rest: bucket lowered to the ground 4.4 m out (the IK's start, as in the paper).
     q_rest: tuple[float, float, float, float] = (0.0, 0.3, -1.8, -1.2)

@@ -1,0 +1,143 @@
+"""Bucket-path generation for one dig cycle (the step the paper announces next).
+
+The paper ends with "the next study will build the generation of the
+bucket-tip path for digging"; this module is our version of it. A path is a
+list of bucket poses (tip position in frame M, bucket angle ``beta``), each
+turned into joint angles by the Newton-Raphson IK (eq. 9-13) at the policy.
+
+Phases and bucket angles (``beta``: elevation of the pin-to-tip axis; the
+bucket opening faces ``(sin beta, -cos beta)`` in the boom plane):
+
+* approach: tip 2 m above the far end of the zone, bucket open
+  (``beta = -1.4``, teeth down and slightly out);
+* penetrate: down to the cut depth ``d`` 0.4 m inside the far end;
+* drag: toward the machine at ``surface(r) - d`` in 0.25 m steps, the bucket
+  turning to ``beta = -1.75`` (opening toward the machine);
+* curl: bucket to ``beta_carry = -2.6`` (opening up), tip 0.3 m higher;
+* lift: tip straight up to 0.8 m above the surface;
+* carry: bucket pin over the truck's near half at the carry height
+  ``rim + L4 + bucket radius + 0.3 m`` (the opened bucket then clears the rim);
+* swing: the same pose at the truck's azimuth (only the swing joint moves);
+* dump: bucket pin fixed, ``beta = -0.35`` (opening down: the soil pours).
+
+Pipe: the cut depth is the zone's marked depth, or less where the pipe runs
+within reach of the strip in plan: then the bucket's lowest point (tip minus
+the bucket radius) stays ``safety + 0.25 m`` above the pipe's top.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from motiongym.envs.excavator.config import Machine
+from motiongym.envs.geometry import closest_points_between_segments
+
+BETA_OPEN = -1.4
+BETA_DRAG = -1.75
+BETA_CARRY = -2.6
+BETA_DUMP = -0.35
+PIPE_MARGIN = 0.25  # m beyond the safety distance
+DRAG_STEP = 0.25  # m
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """A bucket pose along the cycle."""
+
+    phase: str
+    tip: tuple[float, float, float]  # m, frame M
+    beta: float  # rad
+
+
+def allowed_depth(
+    zone: np.ndarray, pipe: np.ndarray, m: Machine, safety: float, surface: float = 0.0
+) -> float:
+    """Deepest cut (m below ``surface``) that keeps the bucket clear of the pipe.
+
+    Args:
+        zone: ``[x_near, y_near, x_far, y_far, depth]`` (the observation's slice).
+        pipe: ``[ax, ay, az, bx, by, bz, radius]``.
+        m: the machine (bucket width and radius).
+        safety: the pipe safety distance (m).
+        surface: the ground height over the zone (m).
+    """
+    near, far = zone[0:2], zone[2:4]
+    a, b, radius = pipe[0:2], pipe[3:5], float(pipe[6])
+    plan, _, _ = closest_points_between_segments(near, far, a, b)
+    r_bucket = m.link_radius[2]
+    reach = float(plan) - 0.5 * m.bucket_width - r_bucket - radius
+    if reach > safety + PIPE_MARGIN:
+        return float(zone[4])
+    top = max(float(pipe[2]), float(pipe[5])) + radius
+    lowest_tip = top + r_bucket + safety + PIPE_MARGIN
+    return float(max(min(zone[4], surface - lowest_tip), 0.0))
+
+
+def dig_path(
+    azimuth: float,
+    r_near: float,
+    r_far: float,
+    depth: float,
+    surface,
+) -> list[Waypoint]:
+    """Approach, penetrate, drag and curl waypoints along the ray at ``azimuth``.
+
+    ``surface(r)`` gives the ground height at radius ``r`` on that ray (m).
+    """
+    c, s = math.cos(azimuth), math.sin(azimuth)
+
+    def at(r: float, z: float) -> tuple[float, float, float]:
+        return (c * r, s * r, z)
+
+    start = r_far - 0.4
+    path = [
+        Waypoint("approach", at(r_far, surface(r_far) + 2.0), BETA_OPEN),
+        Waypoint("approach", at(r_far, surface(r_far) + 0.3), BETA_OPEN),
+        Waypoint("penetrate", at(start, surface(start) - depth), BETA_OPEN),
+    ]
+    n = max(int(math.ceil((start - r_near) / DRAG_STEP)), 1)
+    for k in range(1, n + 1):
+        r = start - (start - r_near) * k / n
+        beta = BETA_OPEN + (BETA_DRAG - BETA_OPEN) * k / n
+        path.append(Waypoint("drag", at(r, surface(r) - depth), beta))
+    return path
+
+
+def curl_lift_path(tip: np.ndarray, surface_here: float) -> list[Waypoint]:
+    """Curl in place (tip 0.3 m up), then lift straight up 0.8 m above the surface."""
+    x, y, z = (float(v) for v in tip)
+    return [
+        Waypoint("curl", (x, y, z + 0.3), BETA_CARRY),
+        Waypoint("lift", (x, y, max(z + 0.6, surface_here + 0.8)), BETA_CARRY),
+    ]
+
+
+def carry_dump_path(
+    dig_azimuth: float, truck: np.ndarray, m: Machine
+) -> tuple[list[Waypoint], float]:
+    """Carry (at the dig azimuth), swing (to the truck), dump; also the truck's azimuth.
+
+    The bucket pin is placed 0.35 m inside the truck's centre radius, at
+    ``rim + L4 + r_bucket + 0.3``; the tip follows from ``beta_carry``.
+    """
+    cx, cy, rim = float(truck[0]), float(truck[1]), float(truck[5])
+    r_truck = math.hypot(cx, cy)
+    azimuth = math.atan2(cy, cx)
+    pin_r = r_truck - 0.35
+    pin_z = rim + m.L4 + m.link_radius[2] + 0.3
+    tip_r = pin_r + m.L4 * math.cos(BETA_CARRY)
+    tip_z = pin_z + m.L4 * math.sin(BETA_CARRY)
+    dump_r = pin_r + m.L4 * math.cos(BETA_DUMP)
+    dump_z = pin_z + m.L4 * math.sin(BETA_DUMP)
+
+    def at(phi: float, r: float, z: float) -> tuple[float, float, float]:
+        return (math.cos(phi) * r, math.sin(phi) * r, z)
+
+    return [
+        Waypoint("carry", at(dig_azimuth, tip_r, tip_z), BETA_CARRY),
+        Waypoint("swing", at(azimuth, tip_r, tip_z), BETA_CARRY),
+        Waypoint("dump", at(azimuth, dump_r, dump_z), BETA_DUMP),
+    ], azimuth
