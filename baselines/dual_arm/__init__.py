@@ -1,5 +1,16 @@
-"""Scripted reference policies for the dual arm world."""
+"""Scripted reference policies for the dual-arm cell (paper 001: time delay by
+boundary following on the collision map), and the schedules they compare with."""
 
 from __future__ import annotations
 
-POLICIES: dict[str, dict[str, str]] = {}
+_MODULE = "motiongym.baselines.dual_arm.policies"
+
+POLICIES: dict[str, dict[str, str]] = {
+    "motiongym/DualArmCell-v0": {
+        "boundary-following": f"{_MODULE}:BoundaryFollowingPolicy",
+        "exhaustive-delay": f"{_MODULE}:ExhaustiveDelayPolicy",
+        "sequential": f"{_MODULE}:SequentialPolicy",
+        "min-makespan": f"{_MODULE}:MinMakespanPolicy",
+        "undelayed": f"{_MODULE}:UndelayedPolicy",
+    },
+}

@@ -53,8 +53,9 @@ class BoundaryResult:
         delay: start delay of robot 2 in samples (None: the method failed).
         departure: dp as ``(s1, s2)`` (None if no region was met).
         evaluated: distinct map cells evaluated.
-        trace: every cell visited, in order, as ``(s1, s2, mode)`` with mode
-            "t" (on the TLVST curve) or "b" (following a boundary).
+        trace: every move made, in order, as ``(s1, s2, mode)``: the cell left
+            and how, "t" along the TLVST curve, "b" along a region's boundary
+            (the last entry is the curve's end).
         candidates: the departure candidates in the order they were taken.
         rounds: how many times step 4 found another region.
         reason: why it failed ("" on success).
@@ -103,13 +104,14 @@ def _search(
     departure: tuple[int, int] | None = None
     seen: dict[tuple[int, int, int], int] = {}
     for _ in range(max_steps):
-        result.trace.append((s1, s2, mode))
         if mode == "t":
             move = cmap.next_on_curve(s1, s2, delay)
             if move is None:
+                result.trace.append((s1, s2, "t"))
                 return delay, departure
             dx, dy = MOVES[move]
             if not _blocked(cmap, s1 + dx, s2 + dy):
+                result.trace.append((s1, s2, "t"))
                 s1, s2 = s1 + dx, s2 + dy
                 continue
             mode, heading = "b", (move + 3) % 4  # region ahead: turn right, keep it left
@@ -127,6 +129,7 @@ def _search(
             result.reason = f"boundary walk cycles at {(s1, s2)} with no new candidate"
             return None
         seen[state] = len(taken)
+        result.trace.append((s1, s2, "b"))
         heading = move
         s1, s2 = s1 + MOVES[move][0], s2 + MOVES[move][1]
     result.reason = f"no end after {max_steps} steps"

@@ -1,0 +1,118 @@
+"""The dual-arm schedules as scripted policies acting from the observation.
+
+At an episode's first step each policy rebuilds both arms' trajectories from
+the tasks in the observation (``world.tasks_from_observation``), builds the
+collision map (``N_l = 100`` by default, the environment's ``safety_margin``
+plus an optional ``plan_margin``) and plans robot 2's schedule; then each step
+it reads the step index from the observation's elapsed time and returns the
+planned advances: robot 1 always 1 (its nominal schedule, as in the paper),
+robot 2 the schedule's 0 or 1. Works for ``control="both"`` (action (2,)) and
+``control="robot_2"`` (action (1,)).
+
+Policies: ``boundary-following`` (the paper; falls back to sequential
+operation where the method fails, and says so in the memory), ``exhaustive-delay``
+(minimum delay over the full map), ``sequential`` (robot 2 starts when robot 1
+ends), ``min-makespan`` (robot 2 pauses and resumes on a shortest monotone
+path, beyond the paper), ``undelayed`` (both start together: collides on the
+sampled "colliding" pairs; a reference only).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from motiongym.baselines.dual_arm import schedules
+from motiongym.baselines.dual_arm.boundary_following import boundary_following
+from motiongym.baselines.dual_arm.collision_map import CollisionMap
+from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.envs.dual_arm.task import DT
+from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
+
+
+class SchedulePolicy(ScriptedPolicy):
+    """Base: plan robot 2's schedule on the episode's first step, then replay it.
+
+    Args:
+        n_levels: ``N_l``, robot 2's length divisions on the map.
+        plan_margin: extra clearance (m) the planner demands beyond the
+            environment's ``safety_margin``.
+    """
+
+    def __init__(
+        self,
+        observation_space: spaces.Space,
+        action_space: spaces.Space,
+        env_kwargs: dict[str, Any] | None = None,
+        n_levels: int = 100,
+        plan_margin: float = 0.0,
+    ) -> None:
+        super().__init__(observation_space, action_space, env_kwargs)
+        if action_space.shape not in ((1,), (2,)):
+            raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
+        self.n_levels = int(n_levels)
+        self.margin = float(self.env_kwargs.get("safety_margin", 0.0)) + float(plan_margin)
+
+    def new_memory(self) -> dict[str, Any]:
+        return {"schedule": None, "map": None}
+
+    def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        raise NotImplementedError
+
+    def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
+        obs = np.asarray(observation, dtype=float)
+        if memory["schedule"] is None:
+            traj1, traj2 = tasks_from_observation(obs)
+            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, self.margin)
+            memory["map"] = cmap
+            memory["schedule"] = self.plan(cmap, memory)
+        step = int(round(float(obs[OBS["elapsed"]][0]) / DT))
+        adv = memory["schedule"].advances
+        a2 = float(adv[step]) if step < len(adv) else 1.0
+        if self.action_space.shape == (2,):
+            return np.array([1.0, a2], dtype=np.float32)
+        return np.array([a2], dtype=np.float32)
+
+
+class BoundaryFollowingPolicy(SchedulePolicy):
+    """The paper's minimum start delay by boundary following (section III)."""
+
+    def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        result = boundary_following(cmap)
+        memory["result"] = result
+        memory["fallback"] = result.delay is None
+        if result.delay is None:
+            return schedules.sequential(cmap)
+        return schedules.delay_schedule(cmap, result.delay)
+
+
+class ExhaustiveDelayPolicy(SchedulePolicy):
+    """Minimum start delay by scanning every delay on the full map."""
+
+    def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        delay = schedules.exhaustive_min_delay(cmap)
+        return schedules.delay_schedule(cmap, cmap.n1 if delay is None else delay)
+
+
+class SequentialPolicy(SchedulePolicy):
+    """Robot 2 starts when robot 1 has finished."""
+
+    def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        return schedules.sequential(cmap)
+
+
+class MinMakespanPolicy(SchedulePolicy):
+    """Robot 2 pauses and resumes on the shortest monotone path through free cells."""
+
+    def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        found = schedules.min_makespan(cmap)
+        return found if found is not None else schedules.sequential(cmap)
+
+
+class UndelayedPolicy(SchedulePolicy):
+    """Both arms start together and run at nominal speed (no coordination)."""
+
+    def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        return schedules.delay_schedule(cmap, 0)

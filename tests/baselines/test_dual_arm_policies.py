@@ -1,0 +1,66 @@
+"""Each dual-arm scripted policy reaches its stated success rate in the environment."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import motiongym  # noqa: F401
+from motiongym.baselines import make_policy, scripted_policies
+
+ID = "motiongym/DualArmCell-v0"
+EXPECTED = {  # success rate on sampled colliding pairs
+    "boundary-following": 1.0,
+    "exhaustive-delay": 1.0,
+    "sequential": 1.0,
+    "min-makespan": 1.0,
+    "undelayed": 0.0,
+}
+
+
+def _run(env, policy, seed, options=None):
+    obs, info = env.reset(seed=seed, options=options)
+    policy.reset()
+    done = False
+    while not done:
+        action, _ = policy.predict(obs)
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    return info
+
+
+def test_declared():
+    assert set(scripted_policies(ID)) == set(EXPECTED)
+
+
+@pytest.mark.parametrize("control", ["both", "robot_2"])
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_success_rate(name, control):
+    env = gym.make(ID, control=control)
+    policy = make_policy(ID, name, env.observation_space, env.action_space, {"control": control})
+    infos = [_run(env, policy, seed) for seed in range(4)]
+    assert np.mean([i["is_success"] for i in infos]) == EXPECTED[name]
+
+
+def test_makespans_ordered_on_the_paper_case():
+    env = gym.make(ID)
+    span = {}
+    for name in ("boundary-following", "exhaustive-delay", "sequential", "min-makespan"):
+        policy = make_policy(ID, name, env.observation_space, env.action_space, {})
+        info = _run(env, policy, 0, {"task": "paper"})
+        assert info["is_success"]
+        span[name] = info["makespan"]
+    assert span["boundary-following"] == span["exhaustive-delay"]
+    assert span["min-makespan"] <= span["boundary-following"] < span["sequential"]
+
+
+def test_batched_predict_keeps_one_plan_per_env():
+    env = gym.make(ID)
+    policy = make_policy(ID, "boundary-following", env.observation_space, env.action_space, {})
+    a, _ = env.reset(seed=1)
+    b, _ = env.reset(seed=2)
+    actions, _ = policy.predict(np.stack([a, b]), episode_start=np.array([True, True]))
+    assert actions.shape == (2, 2)
+    assert len(policy._memories) == 2
+    assert policy._memories[0]["result"].delay != policy._memories[1]["result"].delay

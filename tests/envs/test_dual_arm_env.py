@@ -1,0 +1,137 @@
+"""DualArmCell-v0 and the PettingZoo parallel env: API, reward, determinism, errors."""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import pickle
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test, parallel_seed_test
+from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+import motiongym  # noqa: F401
+from motiongym.envs.dual_arm import parallel_env
+from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
+
+ID = "motiongym/DualArmCell-v0"
+
+
+@pytest.mark.parametrize("control", ["both", "robot_2"])
+def test_api_checks(control):
+    env = gym.make(ID, control=control)
+    check_env(env.unwrapped, skip_render_check=True)
+    sb3_check_env(env.unwrapped, warn=False)
+    assert env.action_space.shape == ((2,) if control == "both" else (1,))
+
+
+def test_reward_terms_sum_and_info():
+    env = gym.make(ID)
+    obs, info = env.reset(seed=1)
+    for key in ("is_success", "cost", "distance", "makespan", "collision"):
+        assert key in info
+    rng = np.random.default_rng(0)
+    for _ in range(300):
+        obs, reward, terminated, truncated, info = env.step(rng.uniform(0, 1, 2))
+        terms = sum(v for k, v in info.items() if k.startswith("reward_"))
+        assert reward == pytest.approx(terms)
+        assert env.observation_space.contains(obs)
+        if terminated:
+            assert info["collision"] or info["is_success"]
+            assert info["cost"] == float(info["collision"])
+            break
+    measures = env.unwrapped.metadata["info_measures"]
+    assert set(measures) <= set(info)
+
+
+def test_determinism_and_tasks_in_observation():
+    env = gym.make(ID)
+    a, _ = env.reset(seed=7)
+    b, _ = env.reset(seed=7)
+    np.testing.assert_array_equal(a, b)
+    c, _ = env.reset(seed=8)
+    assert not np.array_equal(a, c)
+    t1, t2 = tasks_from_observation(a)
+    np.testing.assert_allclose(a[OBS["q1"]], t1.samples()[0], atol=1e-6)
+    np.testing.assert_allclose(a[OBS["q2"]], t2.samples()[0], atol=1e-6)
+
+
+def test_nominal_progress_follows_the_trajectory():
+    env = gym.make(ID, task="paper")
+    obs, _ = env.reset(seed=0)
+    t1, t2 = tasks_from_observation(obs)
+    for _ in range(10):
+        obs, *_ = env.step(np.array([1.0, 0.0]))
+    np.testing.assert_allclose(obs[OBS["q1"]], t1.samples()[10], atol=1e-6)
+    np.testing.assert_allclose(obs[OBS["q2"]], t2.samples()[0], atol=1e-6)
+    obs, *_ = env.step(np.array([0.5, 0.5]))  # halfway between samples
+    np.testing.assert_allclose(obs[OBS["q1"]], (t1.samples()[10] + t1.samples()[11]) / 2, atol=1e-6)
+
+
+def test_undelayed_paper_case_collides_and_terminates():
+    env = gym.make(ID, task="paper")
+    env.reset(seed=0)
+    for _ in range(200):
+        _, reward, terminated, _, info = env.step(np.ones(2))
+        if terminated:
+            break
+    assert info["collision"] and info["cost"] == 1.0 and not info["is_success"]
+    assert 0.6 <= info["makespan"] <= 0.8  # first contact of the paper case at 0.72 s
+    assert info["reward_collision"] == -10.0
+
+
+def test_bad_input():
+    env = gym.make(ID)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(3))
+    with pytest.raises(ValueError, match="NaN"):
+        env.step(np.array([np.nan, 0.0]))
+    with pytest.raises(ValueError, match="task"):
+        env.reset(options={"speed": 2})
+    with pytest.raises(ValueError, match="colliding"):
+        env.reset(options={"task": "nope"})
+    with pytest.raises(ValueError, match="robot_2"):
+        gym.make(ID, control="robot_3")
+    with pytest.raises(TypeError):
+        gym.make(ID, speed=2.0)
+
+
+def test_pickle_mid_episode():
+    env = gym.make(ID)
+    env.reset(seed=3)
+    for _ in range(5):
+        env.step(np.array([1.0, 0.3]))
+    clone = pickle.loads(pickle.dumps(env))
+    a = env.step(np.array([0.7, 0.7]))
+    b = clone.step(np.array([0.7, 0.7]))
+    np.testing.assert_array_equal(a[0], b[0])
+    assert a[1] == b[1]
+
+
+def test_render_rgb_array():
+    env = gym.make(ID, render_mode="rgb_array")
+    env.reset(seed=0)
+    frame = env.render()
+    assert frame.shape == (480, 640, 3) and frame.dtype == np.uint8 and frame.std() > 5
+    env.close()
+
+
+def test_pettingzoo_parallel_env():
+    parallel_api_test(parallel_env(), num_cycles=200)
+    parallel_seed_test(lambda: parallel_env())
+    env = parallel_env(task="paper")
+    obs, infos = env.reset(seed=0)
+    assert set(obs) == {"robot_1", "robot_2"}
+    steps = 0
+    while env.agents:
+        _, rewards, terms, truncs, infos = env.step({"robot_1": np.ones(1), "robot_2": np.zeros(1)})
+        assert rewards["robot_1"] == rewards["robot_2"]
+        steps += 1
+    # robot 2 never moves: robot 1 finishes alone, but robot 2 is not done: truncated
+    assert truncs["robot_1"] and steps == 1000
