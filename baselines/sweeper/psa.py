@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper.world import DC, DR, box_sum
 
 
 @dataclass(frozen=True)
@@ -80,12 +80,11 @@ def segment_configs(seg: Segment) -> tuple[np.ndarray, np.ndarray]:
     return seg.start[0] + k * int(DR[seg.heading]), seg.start[1] + k * int(DC[seg.heading])
 
 
-def covers_unswept(occ: np.ndarray, swept: np.ndarray, w: int) -> np.ndarray:
-    """``(H, W)`` bool: configurations whose footprint holds a cell neither swept nor obstacle."""
-    from motiongym.envs.sweeper.world import box_sum
-
+def covers_unswept(occ: np.ndarray, swept: np.ndarray, w: int, at_least: int = 1) -> np.ndarray:
+    """``(H, W)`` bool: configurations whose footprint holds ``at_least`` cells neither
+    swept nor obstacle."""
     todo = (~swept) & (occ != 1)
-    return box_sum(todo.astype(np.int64), w) > 0
+    return box_sum(todo.astype(np.int64), w) >= at_least
 
 
 def first_target(

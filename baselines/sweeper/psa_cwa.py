@@ -62,6 +62,9 @@ class Memory:
 class PsaCwaPolicy(ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
+    cwa_order = "scan"
+    pop_min_new = 1
+
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
         self.w, self.R = robot_geometry(observation_space, self.env_kwargs)
@@ -171,7 +174,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return None
         origin, occ, swept, cfree, cur = self._known(m, r, c)
         dist = world.bfs_distance(cfree, cur)
-        todo = psa.covers_unswept(occ, swept, self.w)
+        todo = psa.covers_unswept(occ, swept, self.w, self.pop_min_new)
         while len(m.stack):
             seg = m.stack.pop()
             found = psa.first_target(seg, origin, dist >= 0, todo, dist)
@@ -261,6 +264,20 @@ class PsaCwaPolicy(ScriptedPolicy):
         return cells[(~swept) & (occ != OBSTACLE)]
 
     def _cwa_pop(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        if self.cwa_order == "nearest" and len(m.cwa_stack) > 1:
+            origin, _, _, cfree, cur = self._known(m, r, c)
+            dist = world.bfs_distance(cfree, cur)
+            best, best_k = None, len(m.cwa_stack) - 1
+            for k, (_, cells) in enumerate(m.cwa_stack):
+                cells = self._remaining(m, cells)
+                t = (
+                    cwa.nearest_cover(dist, cells - np.array(origin), self.w)
+                    if len(cells)
+                    else None
+                )
+                if t is not None and (best is None or dist[t] < best):
+                    best, best_k = dist[t], k
+            m.cwa_stack.append(m.cwa_stack.pop(best_k))
         while m.cwa_stack:
             seed, cells = m.cwa_stack.pop()
             cells = self._remaining(m, cells)
