@@ -79,6 +79,7 @@ class PotentialFieldPolicy(_ArmPolicy):
     """The paper's method: potential-field path, reference velocities, eq. 1."""
 
     interior_only = True  # the paper's applicability tests of eq. 9-10
+    both_ends = False  # the paper's X_i: a link's terms go to its proximal point
 
     def new_memory(self) -> dict[str, Any]:
         return {"path": None, "index": 0}
@@ -144,20 +145,24 @@ class PotentialFieldPolicy(_ArmPolicy):
         sphere = mask & ~o["is_bar"]
         bar = mask & o["is_bar"]
         w_d = trajectory_following(points, v)
-        r, interior = self.link_radius, self.interior_only
-        w_ob = point_obstacle_terms(
-            points, o["a"][sphere], o["radius"][sphere], r, interior_only=interior
+        r, ext = (
+            self.link_radius,
+            {"interior_only": self.interior_only, "both_ends": self.both_ends},
         )
-        w_ob += bar_obstacle_terms(
-            points, o["a"][bar], o["b"][bar], o["radius"][bar], r, interior_only=interior
-        )
+        w_ob = point_obstacle_terms(points, o["a"][sphere], o["radius"][sphere], r, **ext)
+        w_ob += bar_obstacle_terms(points, o["a"][bar], o["b"][bar], o["radius"][bar], r, **ext)
         return combine(w_d, w_ob, GRIPPER_SPEED)
 
 
 class ExtendedPotentialFieldPolicy(PotentialFieldPolicy):
-    """The paper's method with eq. 9-10 also acting beyond the links' ends (our extension)."""
+    """The paper's method with our two extensions of eq. 9-10.
+
+    A link's obstacle terms also go to its distal point, and they also act on
+    obstacles beyond the link's ends (closest point of the segment).
+    """
 
     interior_only = False
+    both_ends = True
 
 
 class ResolvedRatePolicy(_ArmPolicy):

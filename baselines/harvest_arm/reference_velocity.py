@@ -2,17 +2,21 @@
 
 The arm is a chain of joint points ``X_0 .. X_L`` (base to gripper); link
 ``i`` is the segment ``X_i X_{i+1}`` with ``U = X_{i+1} - X_i`` and
-``u = U / |U|``; ``v`` is the unit direction of the gripper's travel.
+``u = U / |U|``; ``v`` is the unit direction of the gripper's travel. As the
+paper writes them, every term of link ``i`` is the reference velocity
+``X_i_dot`` of its *proximal* joint point ``X_i`` (the gripper ``X_L`` is
+bound to its path by eq. 1, the base ``X_0`` does not move).
 
-* Trajectory following (eq. 8): ``w_d = (v x u) x u``. That vector is
-  ``-(v - (v.u) u)``; we use ``+(v - (v.u) u)``, the component of ``v``
-  perpendicular to the link, applied at the link's distal point, which is
-  the point the link's rotation moves. With that sign a joint moves the way
-  the gripper went and the joints trace the gripper's path (paper Fig. 3;
-  tested); with the printed sign they move against it.
+* Trajectory following (eq. 8): ``w_d = (v x u) x u = -(v - (v.u) u)``, the
+  printed sign. At ``X_i`` it turns link ``i`` towards the direction of
+  travel (the proximal end moves against ``v``'s perpendicular part while
+  the distal end goes with the gripper), so each link lines up with the
+  path and the joints trace the gripper's trajectory (paper Fig. 3). The
+  spec asked for the sign that makes the joints follow the path: it is the
+  printed one applied at ``X_i``; the opposite sign traces worse (tested).
 * Point obstacle (eq. 9): ``C = Ob_j - X_i``; the term acts when the
   obstacle projects onto the link (``0 <= C.U <= |U|^2``) and its distance
-  ``rho`` to the link's line is below ``rho0``. Direction
+  ``rho = |C| sin(C, U)`` to the link's line is below ``rho0``. Direction
   ``(C x u) x u`` normalised, i.e. perpendicular to the link, away from the
   obstacle; magnitude eq. 5 with the obstacle-avoidance row of Tables 1-2.
 * Bar obstacle (eq. 10): direction the common normal of link and bar,
@@ -22,14 +26,16 @@ The arm is a chain of joint points ``X_0 .. X_L`` (base to gripper); link
   perpendicular falls inside both segments": the closest points of the two
   segments are interior to both, and then the common normal is the
   direction between them (which also serves in 2-D).
-* Combination (eq. 11): ``w = w_d + sum w_ob``, normalised only when
+* Combination (eq. 11): ``w = w_d + sum_j w_ob_j``, normalised only when
   ``|w| > 1``; ``X_i_dot = |V_i_ref| w``.
 
 Where the paper is silent: ``rho`` is the surface clearance (line or
-segment distance minus the link and obstacle radii); each link's terms go to
-its distal point, except the last link's, whose distal point is the gripper
-(bound to its own path by eq. 1): its obstacle terms go to its proximal
-point. ``|V_i_ref|`` is the gripper's reference speed for every point.
+segment distance minus the link and obstacle radii); ``|V_i_ref|`` is the
+gripper's reference speed for every point. Two extensions, off by default
+(the ``potential-field-extended`` policy turns them on): ``both_ends`` gives
+a link's obstacle terms to its distal point as well (except the gripper),
+and ``interior_only=False`` lets the terms act on obstacles beyond the
+link's ends.
 """
 
 from __future__ import annotations
@@ -53,21 +59,26 @@ def _links(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return U, length, U / np.maximum(length, _EPS)[:, None]
 
 
-def _to_points(per_link: np.ndarray) -> np.ndarray:
-    """Move each link's term to the point it drives: (L, dim) -> (P, dim)."""
+def _to_points(per_link: np.ndarray, both_ends: bool = False) -> np.ndarray:
+    """Give each link's term to its proximal point (and distal): (L, dim) -> (P, dim)."""
     L, dim = per_link.shape
     out = np.zeros((L + 1, dim))
-    out[:L] += per_link  # proximal points (the paper's X_i)
-    out[1:L] += per_link[: L - 1]  # distal points, except the gripper
+    out[:L] += per_link  # proximal points: the paper's X_i
+    if both_ends:
+        out[1:L] += per_link[: L - 1]  # distal points, except the gripper
     return out
 
 
-def trajectory_following(points: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Eq. 8 direction ``w_d`` at every point (P, dim); zero at base and gripper."""
+def trajectory_following(points: np.ndarray, v: np.ndarray, sign: float = 1.0) -> np.ndarray:
+    """Eq. 8 direction ``w_d = (v x u) x u`` at every point (P, dim); zero at the gripper.
+
+    ``sign=-1`` flips it (for the test that the printed sign is the one
+    that traces the path).
+    """
     _, _, u = _links(points)
-    w = v[None, :] - (u @ v)[:, None] * u  # (L, dim): v perpendicular to each link
+    w = (u @ v)[:, None] * u - v[None, :]  # (L, dim): (v x u) x u = (v.u) u - v
     out = np.zeros_like(points)
-    out[1:-1] = w[:-1]  # distal point of links 0 .. L-2; the gripper follows its path
+    out[:-1] = sign * w  # X_i, the proximal point of link i
     return out
 
 
@@ -78,6 +89,7 @@ def point_obstacle_terms(
     link_radius: float = 0.0,
     params: FieldParameters = AVOIDANCE,
     interior_only: bool = True,
+    both_ends: bool = False,
 ) -> np.ndarray:
     """Eq. 9 terms ``w_ob`` of sphere obstacles (K, dim), summed per point: (P, dim).
 
@@ -103,7 +115,7 @@ def point_obstacle_terms(
     inside &= rho < params.rho0
     mag = np.where(inside, obstacle_magnitude(rho, params), 0.0)  # (L, K)
     away = -perp / np.maximum(dist, _EPS)[..., None]  # ((C x u) x u) normalised
-    return _to_points((mag[..., None] * away).sum(axis=1))
+    return _to_points((mag[..., None] * away).sum(axis=1), both_ends)
 
 
 def bar_obstacle_terms(
@@ -114,6 +126,7 @@ def bar_obstacle_terms(
     link_radius: float = 0.0,
     params: FieldParameters = AVOIDANCE,
     interior_only: bool = True,
+    both_ends: bool = False,
 ) -> np.ndarray:
     """Eq. 10 terms ``w_obl`` of bar obstacles ``a``-``b`` (K, dim), per point: (P, dim).
 
@@ -135,7 +148,7 @@ def bar_obstacle_terms(
     rho = dist - radius[None, :] - link_radius
     mag = np.where(interior & (rho < params.rho0), obstacle_magnitude(rho, params), 0.0)
     away = (on_link - on_bar) / np.maximum(dist, _EPS)[..., None]  # common normal, off the bar
-    return _to_points((mag[..., None] * away).sum(axis=1))
+    return _to_points((mag[..., None] * away).sum(axis=1), both_ends)
 
 
 def combine(w_d: np.ndarray, w_ob: np.ndarray, speed: float) -> np.ndarray:

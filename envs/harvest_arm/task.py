@@ -2,23 +2,26 @@
 
 The paper generates "8 random obstacles" in the plane and "10 random
 obstacles, 3 in 10 bars" in space, and does not say where. Our scene
-distribution (fixed for the ``-v0`` IDs):
+distribution (fixed for the ``-v0`` IDs), a canopy around the fruit:
 
-* Planar (x-y, base at the origin): obstacles are immature fruit, circles of
-  radius U(0.015, 0.03) m, centres uniform in the canopy box
-  x in [0.05, 0.85], y in [-0.6, 0.2]; the fruit in x in [0.2, 0.8],
-  y in [-0.6, -0.1]. No bars in the plane (the paper's bars are a 3-D case).
-* Spatial (z up, shoulder at z = 0.3302): spheres of radius U(0.015, 0.03) m
-  and exactly ``n_bars`` branches (capsules of radius 0.01 m, length
-  U(0.2, 0.5) m, direction uniform on the sphere, centre in the box), in the
-  canopy box x in [0.15, 0.85], y in [-0.4, 0.4], z in [0.05, 0.75]; the
-  fruit in x in [0.4, 0.8], y in [-0.35, 0.35], z in [0.1, 0.45].
-* Rejection: an obstacle must keep 0.05 m clear of the arm's start pose and
-  0.06 m of surface clearance from the fruit sphere (radius
-  ``FRUIT_RADIUS``), so that the gripper can reach the fruit's centre. The
-  fruit must be at least 0.25 m from the start gripper and reachable: a
-  damped least-squares IK within the joint limits must bring the gripper
-  within 2 mm of it.
+* The fruit: uniform in a fruit box (planar x in [0.2, 0.8], y in
+  [-0.6, -0.1]; spatial x in [0.4, 0.8], y in [-0.35, 0.35], z in
+  [0.1, 0.45]), at least ``MIN_TRAVEL`` = 0.35 m from the start gripper,
+  within ``MAX_REACH`` = 0.8 x 0.861 m of the base (planar) or shoulder
+  (spatial), so that the arm keeps some redundancy at the fruit, and
+  reachable: a damped least-squares IK within the joint limits brings the
+  gripper within 2 mm of it.
+* Obstacle centres: uniform within +-``CLUSTER`` = 0.3 m (per axis) of the
+  fruit, inside the canopy box (planar x in [0.05, 0.85], y in [-0.6, 0.2];
+  spatial x in [0.15, 0.85], y in [-0.4, 0.4], z in [0.05, 0.75]).
+  Immature fruit: spheres (circles in the plane) of radius U(0.01, 0.02) m.
+  Spatial scenes have exactly ``n_bars`` branches: capsules of radius
+  0.008 m, length U(0.2, 0.5) m, direction uniform on the sphere. No bars in
+  the plane (the paper's bars are a 3-D case).
+* Rejection: an obstacle must keep ``START_CLEARANCE`` = 0.05 m from the
+  arm's start pose and ``FRUIT_CLEARANCE`` = 0.06 m of surface clearance
+  from the fruit sphere (radius ``FRUIT_RADIUS``), so that the gripper can
+  reach the fruit's centre.
 
 Everything is drawn from the ``rng`` passed in (the env's ``np_random``).
 """
@@ -30,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from motiongym.envs.geometry import closest_points_between_segments
-from motiongym.envs.harvest_arm.model import ArmKinematics
+from motiongym.envs.harvest_arm.model import REACH, ArmKinematics
 
 FRUIT_RADIUS = 0.035  # m
 SPHERE_RADIUS = (0.01, 0.02)  # m, immature fruit
@@ -39,6 +42,7 @@ BAR_LENGTH = (0.2, 0.5)  # m
 START_CLEARANCE = 0.05  # m, obstacles vs the arm's start pose
 FRUIT_CLEARANCE = 0.06  # m, obstacle surface vs fruit surface
 MIN_TRAVEL = 0.35  # m, fruit vs start gripper
+MAX_REACH = 0.8 * REACH  # m, fruit vs the arm's base (planar) or shoulder (spatial)
 CLUSTER = 0.3  # m, obstacle centres within +-CLUSTER of the fruit (per axis)
 
 PLANAR_BOX = np.array([[0.05, -0.6], [0.85, 0.2]])  # (2, 2): low, high (m)
@@ -141,7 +145,11 @@ def sample_scene(
     start = kin.forward(home)  # (P, dim)
     for _ in range(200):
         fruit = rng.uniform(fruit_box[0], fruit_box[1])
-        if np.linalg.norm(fruit - start[-1]) < MIN_TRAVEL:
+        root = start[0] if planar else start[1]
+        if (
+            np.linalg.norm(fruit - start[-1]) < MIN_TRAVEL
+            or np.linalg.norm(fruit - root) > MAX_REACH
+        ):
             continue
         if solve_ik(kin, fruit, home)[1] < 2e-3:
             break
