@@ -4,7 +4,8 @@ One step (``dt`` s) of the hydraulic machine:
 
 1. action ``a`` (4,) in [-1, 1] -> commanded joint rates ``a * rate_max``;
 2. in soil (carving worlds), rates scaled by the resistance model
-   (:func:`motiongym.envs.excavator.soil.speed_fraction` at the tip's depth);
+   (:func:`motiongym.envs.excavator.soil.speed_fraction` at the depth of cut
+   of the previous step, the soil thickness the cutting edge went through);
 3. joint angles integrated and held inside the joint ranges (the rate of a
    joint at its stop is zero);
 4. forward kinematics (:func:`arm_points`, the scalar form of eq. 4);
@@ -177,7 +178,7 @@ class ExcavatorBase(gym.Env):
         m, dt = self.m, self.dt
         scale = 1.0
         if self.CARVE:
-            depth = self._ground_at_tip - self.tip[2]
+            depth = self.terrain.last_cut_depth
             if depth > 0.0:
                 scale = speed_fraction(depth, m.bucket_width, m)
         q, qdot = self.q, self.qdot
@@ -209,7 +210,6 @@ class ExcavatorBase(gym.Env):
         self.points = arm_points(*self.q, self.m)
         self.tip = self.points[3]
         self.beta = self.q[1] + self.q[2] + self.q[3]
-        self._ground_at_tip = self.terrain.height_at(self.tip[0], self.tip[1])
 
     def _edge(self) -> tuple[np.ndarray, np.ndarray]:
         half = 0.5 * self.m.bucket_width
@@ -225,7 +225,8 @@ class ExcavatorBase(gym.Env):
         if z < top or self._prev_tip_z < top:
             free = m.bucket_capacity - self.fill
             self.fill += self.terrain.carve(self._prev_edge, edge, self._prev_tip_z, z, free)
-            self._ground_at_tip = self.terrain.height_at(self.tip[0], self.tip[1])
+        else:
+            self.terrain.last_cut_depth = 0.0
         self._prev_edge = edge
         self._prev_tip_z = z
         if self.fill > 0.0 and -math.cos(self.beta) < POUR_NZ:
@@ -257,7 +258,7 @@ class ExcavatorBase(gym.Env):
         ox, oy = -self.m.L0 + s1 * self.m.d2, -c1 * self.m.d2  # the plane's origin in plan
         radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
         rmin, rmax = min(radial), max(radial)
-        lowest = min(pts[1][2], pts[2][2], pts[3][2])
+        lowest = min(pts[0][2], pts[1][2], pts[2][2], pts[3][2])
         # Pipe.
         (px, py), (ux, uy), plen = self._pipe_line
         gaps = []

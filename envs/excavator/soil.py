@@ -64,6 +64,7 @@ class Terrain:
         self.cell = float(cell)
         self.nx, self.ny = self.h.shape
         self.version = 0  # bumped on every change (for caches)
+        self.last_cut_depth = 0.0  # m: deepest cut of the last carve (the resistance depth)
         self.max_height = float(self.h.max())
 
     @property
@@ -107,7 +108,11 @@ class Terrain:
                 previous and the current step.
             z0, z1: the edge's height at those steps (m).
             free_capacity: room left in the bucket (m3); the cut is scaled to it.
+
+        Sets :attr:`last_cut_depth`, the thickness of soil the edge went
+        through (the depth of cut of the resistance model).
         """
+        self.last_cut_depth = 0.0
         a0, b0 = np.asarray(edge0[0]), np.asarray(edge0[1])
         a1, b1 = np.asarray(edge1[0]), np.asarray(edge1[1])
         half = 0.5 * self.cell
@@ -130,7 +135,9 @@ class Terrain:
         patch = self.h[i0:i1, j0:j1]  # a view
         old = patch.copy()
         np.minimum.at(self.h, (i, j), zs)
-        removed = float(old.sum() - patch.sum()) * self.cell * self.cell
+        cut = old - patch
+        removed = float(cut.sum()) * self.cell * self.cell
+        self.last_cut_depth = float(cut.max())
         if removed <= 0.0:
             return 0.0
         if removed > free_capacity:

@@ -1,0 +1,167 @@
+"""ExcavatorReach-v0 and Excavator-v0: API, determinism, reward terms, physics, errors."""
+
+from __future__ import annotations
+
+import os
+import pickle
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import gymnasium as gym  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from stable_baselines3.common.env_checker import check_env as sb3_check_env  # noqa: E402
+
+import motiongym  # noqa: E402, F401
+from motiongym.envs.excavator import base  # noqa: E402
+from motiongym.envs.excavator.obstacles import pipe_clearance, truck_clearance  # noqa: E402
+
+IDS = ("motiongym/ExcavatorReach-v0", "motiongym/Excavator-v0")
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_api_checks(env_id):
+    env = gym.make(env_id, render_mode="rgb_array")
+    check_env(env.unwrapped)
+    sb3_check_env(env.unwrapped, warn=False)
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_determinism_reward_terms_and_bounds(env_id):
+    def rollout(seed):
+        env = gym.make(env_id)
+        obs, info = env.reset(seed=seed)
+        rng = np.random.default_rng(0)
+        out = [obs]
+        for _ in range(150):
+            obs, reward, terminated, truncated, info = env.step(rng.uniform(-1, 1, 4))
+            assert env.observation_space.contains(obs)
+            terms = [v for k, v in info.items() if k.startswith("reward_")]
+            assert sum(terms) == pytest.approx(reward, abs=1e-9)
+            for key in env.unwrapped.metadata["info_measures"]:
+                assert np.isscalar(info[key]), key
+            assert info["cost"] in (0.0, 1.0)
+            out.append(obs)
+            if terminated or truncated:
+                break
+        return np.array(out)
+
+    a, b = rollout(7), rollout(7)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(rollout(7)[0], rollout(8)[0])
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_bad_input_raises(env_id):
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(3))
+    with pytest.raises(ValueError, match="finite"):
+        env.step(np.array([0.0, np.nan, 0.0, 0.0]))
+    with pytest.raises(ValueError, match="unknown reset option"):
+        env.reset(options={"target": 1})
+    with pytest.raises(ValueError, match="q0"):
+        env.reset(options={"q0": [0.0, 1.0]})
+    with pytest.raises(ValueError, match="render_mode"):
+        type(env)(render_mode="human")
+    with pytest.raises(TypeError):
+        gym.make(env_id, unknown_weight=1.0)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_pickle_and_render(env_id):
+    env = gym.make(env_id, render_mode="rgb_array", render_size=(120, 160))
+    env.reset(seed=3)
+    env.step(np.zeros(4))
+    image = env.render()
+    assert image.shape == (120, 160, 3) and image.dtype == np.uint8 and image.std() > 5
+    clone = pickle.loads(pickle.dumps(env.unwrapped))
+    action = np.array([0.3, -0.2, 0.5, -1.0])
+    a = env.unwrapped.step(action)[0]
+    b = clone.step(action)[0]
+    np.testing.assert_array_equal(a, b)
+    env.close()
+
+
+def test_reported_clearances_are_exact_near_and_lower_bounds_far():
+    env = gym.make("motiongym/Excavator-v0").unwrapped
+    rng = np.random.default_rng(5)
+    m = env.m
+    for seed in range(15):
+        env.reset(seed=seed)
+        for _ in range(20):
+            env.q = list(rng.uniform(m.q_min, m.q_max))
+            env._forward()
+            env._clearances()
+            starts, ends = np.array(env.points[:3]), np.array(env.points[1:])
+            radii = np.array(m.link_radius)
+            pipe = pipe_clearance(starts, ends, radii, env.pipe)
+            truck = truck_clearance(starts, ends, radii, env.truck)
+            for got, exact in ((env.pipe_clear, pipe), (env.truck_clear, truck)):
+                if exact < base.HORIZON:
+                    assert got == pytest.approx(exact, abs=1e-9)
+                else:
+                    assert base.HORIZON <= got <= exact + 1e-9
+
+
+def test_digging_fills_the_bucket_slows_the_arm_and_pouring_spills():
+    from motiongym.baselines.excavator.newton_raphson import analytic_solutions, within_limits
+
+    env = gym.make("motiongym/Excavator-v0").unwrapped
+    seed = 0
+    env.reset(seed=seed)
+    zone = env.scene.zone
+    tip = np.array([np.cos(zone.azimuth), np.sin(zone.azimuth), 0.0]) * zone.r_far
+    tip[2] = env.terrain.height_at(tip[0], tip[1]) + 0.05
+    q0 = next(s for s in analytic_solutions(tip, -1.6, env.m) if within_limits(s, env.m))
+    env.reset(seed=seed, options={"q0": q0})
+    volume0 = env.terrain.volume()
+    rates = []
+    for _ in range(8):  # boom down: the bucket enters the ground
+        _, _, terminated, _, info = env.step(np.array([0.0, -0.15, 0.0, 0.0]))
+        rates.append(abs(env.qdot[1]) / (0.15 * env.m.rate_max[1]))
+        assert not terminated
+    t = env.terrain
+    i, j = int((env.tip[0] - t.x0) / t.cell), int((env.tip[1] - t.y0) / t.cell)
+    assert env.scene.heights[i, j] - env.tip[2] > 0.3  # below the original surface
+    assert rates[0] == 1.0 and min(rates) < 0.9  # slowed by the soil
+    for _ in range(15):  # stick in: drag toward the machine
+        _, _, terminated, _, info = env.step(np.array([0.0, 0.0, -0.5, -0.2]))
+        assert not terminated
+    assert info["bucket_fill"] > 0.1
+    assert volume0 - env.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
+    # Lift and open the bucket away from the truck: the soil is spilled on the ground.
+    for _ in range(40):
+        _, _, _, _, info = env.step(np.array([0.0, 1.0, 0.0, 1.0]))
+    assert info["spill"] > 0.0 and info["truck_soil"] == 0.0
+    assert info["spill"] + info["bucket_fill"] == pytest.approx(info["dig_fill"], abs=1e-9)
+    assert volume0 - env.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
+
+
+def test_joint_limits_hold_and_rates_are_the_hydraulic_limits():
+    env = gym.make("motiongym/ExcavatorReach-v0").unwrapped
+    env.reset(seed=0)
+    _, _, _, _, _ = env.step(np.ones(4))
+    assert env.qdot == pytest.approx(list(env.m.rate_max))
+    for _ in range(100):
+        env.step(np.ones(4))
+    assert env.q[1] == pytest.approx(env.m.q_max[1])
+    assert env.qdot[1] == 0.0
+
+
+def test_reach_success_terminates_with_the_bonus():
+    from motiongym.baselines.excavator.newton_raphson import analytic_solutions, within_limits
+
+    env = gym.make("motiongym/ExcavatorReach-v0").unwrapped
+    _, info = env.reset(seed=1)
+    assert info["position_error"] > env.tolerance_position and not info["is_success"]
+    target = env.scene.target
+    q = next(s for s in analytic_solutions(target[:3], target[3], env.m) if within_limits(s, env.m))
+    env.reset(seed=1, options={"q0": q})
+    _, reward, terminated, _, info = env.step(np.zeros(4))
+    assert terminated and info["is_success"]
+    assert info["position_error"] < 1e-9 and info["angle_error"] < 1e-9
+    assert info["reward_success"] == env.weights["success"]
