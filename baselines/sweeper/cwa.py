@@ -15,11 +15,13 @@ Our reading (the choices are documented and tested):
 - A cell is a leftover when it is neither swept nor a known obstacle and some
   configuration reachable in the known map covers it (a cell in a gap
   narrower than the robot can never be swept and is not a leftover).
-- "The contour a cell belongs to" is the 8-connected group of leftover cells
-  containing it: leftovers lie along walls and obstacles, so a group is the
-  unswept strip hugging one contour. Scanning rows top to bottom and each
-  row right to left, the first cell met of each group is its seed; seeds are
-  pushed in scan order, so the last pushed (bottom-left) is handled first.
+- "The closed contour a cell belongs to" is the contour of the known
+  obstacle (an 8-connected component of obstacle cells; the outer wall and
+  everything touching it is one) nearest to the cell, within a robot width;
+  all leftovers along that contour form one group. Leftovers farther from
+  any obstacle are grouped by 8-connectivity. Scanning rows top to bottom
+  and each row right to left, the first cell met of each group is its seed;
+  seeds are pushed in scan order, so the last pushed is handled first.
 - "Follow the contour while sweeping": from the seed on, the robot goes to
   the nearest configuration (grid distance in the known map) covering a
   leftover cell of the group, repeatedly, until the group is swept; along a
@@ -41,32 +43,45 @@ def leftovers(occ: np.ndarray, swept: np.ndarray, reach: np.ndarray, w: int) -> 
     return world.footprint_union(reach, w) & ~swept & (occ != 1)
 
 
-def scan_groups(targets: np.ndarray) -> list[tuple[tuple[int, int], np.ndarray]]:
+def scan_groups(
+    targets: np.ndarray, obstacle: np.ndarray | None = None, reach: int = 1
+) -> list[tuple[tuple[int, int], np.ndarray]]:
     """Steps 1-3: ``[(seed, cells)]`` in scan order (top-right to bottom-left).
 
-    ``cells`` is an ``(n, 2)`` array of the group's cells; the caller pushes
-    the list in this order and pops from its end.
+    With ``obstacle`` (known obstacle cells), leftovers within ``reach`` cells
+    of an obstacle belong to the contour of that obstacle (its 8-connected
+    component): one entry per contour, as the paper traces "the closed
+    contour" a leftover touches. Other leftovers (and all of them without
+    ``obstacle``) are grouped by 8-connectivity. ``cells`` is an ``(n, 2)``
+    array; the caller pushes the list in this order and pops from its end.
     """
-    labels, n = ndimage.label(targets, structure=np.ones((3, 3), bool))
-    if n == 0:
+    groups = np.zeros(targets.shape, np.int64)
+    n_obst = 0
+    if obstacle is not None and obstacle.any():
+        obst_labels, n_obst = ndimage.label(obstacle, structure=np.ones((3, 3), bool))
+        dist, (ir, ic) = ndimage.distance_transform_cdt(
+            ~obstacle, metric="chessboard", return_indices=True
+        )
+        near = targets & (dist <= reach)
+        groups[near] = obst_labels[ir[near], ic[near]]
+    rest, n_rest = ndimage.label(targets & (groups == 0), structure=np.ones((3, 3), bool))
+    groups[rest > 0] = rest[rest > 0] + n_obst
+    n = n_obst + n_rest
+    if not targets.any():
         return []
     h, wd = targets.shape
-    # scan order: row-major with columns reversed
-    order = labels[:, ::-1].ravel()
-    first_idx = np.full(n + 1, -1, np.int64)
+    order = groups[:, ::-1].ravel()  # scan order: row-major with columns reversed
     nz = np.flatnonzero(order)
-    lab = order[nz]
-    uniq, pos = np.unique(lab, return_index=True)
-    first_idx[uniq] = nz[pos]
-    seeds = sorted((int(first_idx[k]), k) for k in range(1, n + 1))
-    cells = ndimage.find_objects(labels)
+    uniq, pos = np.unique(order[nz], return_index=True)
+    seeds = sorted((int(nz[p]), int(k)) for k, p in zip(uniq, pos, strict=True))
+    flat = groups.ravel()
+    sort = np.argsort(flat, kind="stable")
+    bounds = np.searchsorted(flat[sort], np.arange(n + 2))
     out = []
     for idx, k in seeds:
         r, cr = divmod(idx, wd)
-        seed = (r, wd - 1 - cr)
-        sl = cells[k - 1]
-        rr, cc = np.nonzero(labels[sl] == k)
-        out.append((seed, np.stack([rr + sl[0].start, cc + sl[1].start], axis=1)))
+        cells = sort[bounds[k] : bounds[k + 1]]
+        out.append(((r, wd - 1 - cr), np.stack(np.divmod(cells, wd), axis=1)))
     return out
 
 

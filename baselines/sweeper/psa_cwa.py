@@ -62,8 +62,7 @@ class Memory:
 class PsaCwaPolicy(ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
-    cwa_order = "scan"
-    pop_min_new = 1
+    cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -174,7 +173,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return None
         origin, occ, swept, cfree, cur = self._known(m, r, c)
         dist = world.bfs_distance(cfree, cur)
-        todo = psa.covers_unswept(occ, swept, self.w, self.pop_min_new)
+        todo = psa.covers_unswept(occ, swept, self.w)
         while len(m.stack):
             seg = m.stack.pop()
             found = psa.first_target(seg, origin, dist >= 0, todo, dist)
@@ -221,7 +220,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return self._restart_psa(m, r, c, origin, cfree, cur, wide, targets)
         m.cwa_stack = [
             ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
-            for s, cells in cwa.scan_groups(targets)
+            for s, cells in cwa.scan_groups(targets, occ == OBSTACLE, self.w)
         ]
         m.mode = "cwa_pop"
         return None

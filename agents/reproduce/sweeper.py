@@ -1,0 +1,374 @@
+"""Reproduce the sweeper paper's evaluation (Park & Lee 1998, section 4) on our maps.
+
+``run(out_dir, quick=False)`` runs, prints beside the paper's figures, and
+writes into ``out_dir`` (``sweeper.json`` and PNG figures):
+
+1. Coverage and travel of PSA + CWA on the room, apartment and maze from
+   random starts and on procedurally generated maps (paper 4.1.1: full
+   coverage "whatever the complexity"); travel against the lower bound
+   (reachable area / W) and the SmartDFS bound ``W (C + E/2)``.
+2. Start-position sensitivity on the maze (4.1.2, Fig. 15): travel from every
+   feasible start configuration (a regular sample with ``quick``), its spread
+   ``(max - min) / min`` beside the paper's ~3 %, and a grey-level image.
+3. Start-orientation sensitivity (4.1.3, Fig. 16-17): the maze turned by
+   0-90 degrees (our robot moves on the grid's axes, so the walls turn),
+   travel spread beside the paper's < 3 %, and the share left to CWA.
+4. Odometry error (4.2, Fig. 20, the paper's open problem): coverage and
+   travel against heading and slip noise.
+5. The weak baseline (section 2, Fig. 1) on an empty room beside the paper's
+   ~90 % coverage.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import time
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+import motiongym  # noqa: F401  (registers the IDs)
+from motiongym.baselines.sweeper.run import make_policy, run_episode
+from motiongym.envs.sweeper import generator, maps, world
+
+ENV_ID = "motiongym/Sweeper-v0"
+W = 3  # robot width (cells) of all studies
+PAPER = {
+    "coverage": "100 % on Fig. 6, 11, 12",
+    "start_spread": 0.03,  # (20843 - 20193) / 20193 = 3.2 %
+    "start_max": 20843,
+    "start_min": 20193,
+    "orientation_spread": 0.03,
+    "weak_coverage": 0.90,
+}
+
+
+def _env(**kwargs: Any) -> gym.Env:
+    return gym.make(ENV_ID, robot_width=W, **kwargs)
+
+
+def _episode(env: gym.Env, policy: str, seed: int | None, options=None, max_steps=None) -> dict:
+    kwargs = {**gym.spec(ENV_ID).kwargs, "robot_width": W}
+    out = run_episode(env, make_policy(policy, env, kwargs), seed, options, max_steps)
+    out.pop("memory")
+    return out
+
+
+def _bound(env: gym.Env) -> float:
+    return world.smartdfs_bound(env.unwrapped.scenario.reachable, W)[2]
+
+
+def coverage_study(quick: bool) -> dict:
+    """PSA + CWA on the shipped maps (random starts) and on procedural maps."""
+    n_starts, n_random = (2, 5) if quick else (10, 50)
+    out: dict[str, Any] = {}
+    for name in maps.SHIPPED_MAPS:
+        env = _env(map_name=name)
+        runs = [_episode(env, "psa-cwa", seed) for seed in range(n_starts)]
+        bound = _bound(env)
+        ratios = [r["travel_ratio"] for r in runs]
+        out[name] = {
+            "episodes": n_starts,
+            "coverage_min": min(r["coverage"] for r in runs),
+            "travel_mean": float(np.mean([r["travel"] for r in runs])),
+            "travel_ratio_mean": float(np.mean(ratios)),
+            "travel_ratio_max": float(np.max(ratios)),
+            "smartdfs_ratio": bound,
+            "below_smartdfs": bool(np.max(ratios) < bound),
+            "overlap_mean": float(np.mean([r["overlap"] for r in runs])),
+            "turns_mean": float(np.mean([r["turns"] for r in runs])),
+            "steps_mean": float(np.mean([r["steps"] for r in runs])),
+            "wall_s_mean": float(np.mean([r["wall_s"] for r in runs])),
+        }
+    env = _env(map_name="random")
+    runs, below = [], 0
+    for seed in range(n_random):
+        r = _episode(env, "psa-cwa", 1000 + seed)
+        below += r["travel_ratio"] < _bound(env)
+        runs.append(r)
+    out["procedural"] = {
+        "episodes": n_random,
+        "coverage_min": min(r["coverage"] for r in runs),
+        "all_swept": int(sum(r["is_success"] for r in runs)),
+        "travel_ratio_mean": float(np.mean([r["travel_ratio"] for r in runs])),
+        "below_smartdfs": int(below),
+    }
+    return out
+
+
+def start_position_study(quick: bool) -> dict:
+    """Travel from every feasible start configuration of the maze (heading east)."""
+    env = _env(map_name="maze")
+    grid = maps.shipped_map("maze")
+    free = world.config_free(grid, W)
+    stride = 4 if quick else 1
+    starts = [tuple(int(v) for v in p) for p in np.argwhere(free) if p[0] % stride == 0]
+    starts = [p for p in starts if p[1] % stride == 0]
+    travel = np.full(grid.shape, np.nan)
+    for start in starts:
+        r = _episode(env, "psa-cwa", 0, {"start": start, "heading": 0})
+        travel[start] = r["travel"]
+    vals = travel[~np.isnan(travel)]
+    return {
+        "starts": len(starts),
+        "travel_min": float(vals.min()),
+        "travel_max": float(vals.max()),
+        "spread": float((vals.max() - vals.min()) / vals.min()),
+        "image": travel,
+    }
+
+
+def _rotated_start(grid: np.ndarray, angle: float, start: tuple[int, int]) -> tuple[int, int]:
+    mark = np.zeros(grid.shape, bool)
+    mark[start[0] : start[0] + W, start[1] : start[1] + W] = True
+    turned = maps.rotate_map(~mark, angle)  # the marked block stays "free"
+    turned[0, :] = turned[-1, :] = turned[:, 0] = turned[:, -1] = True
+    centre = np.argwhere(~turned).mean(axis=0) - (W - 1) / 2
+    free = world.config_free(maps.rotate_map(grid, angle), W)
+    cells = np.argwhere(free)
+    k = int(np.argmin(((cells - centre) ** 2).sum(axis=1)))
+    return int(cells[k, 0]), int(cells[k, 1])
+
+
+def orientation_study(quick: bool) -> dict:
+    """The maze turned by 0..90 degrees; the robot starts in the same corner cell heading east."""
+    grid = maps.shipped_map("maze")
+    angles = [0.0, 30.0, 45.0, 60.0, 90.0] if quick else [float(a) for a in range(0, 91, 5)]
+    rows = []
+    for angle in angles:
+        turned = maps.rotate_map(grid, angle)
+        env = _env(grid=turned)
+        start = _rotated_start(grid, angle, (2, 2))
+        r = _episode(env, "psa-cwa", 0, {"start": start, "heading": 0})
+        rows.append(
+            {
+                "angle": angle,
+                "travel": r["travel"],
+                "travel_ratio": r["travel_ratio"],
+                "coverage": r["coverage"],
+                "left_to_cwa": 1.0 - r["psa_coverage"],
+                "reachable": int(env.unwrapped.n_reach),
+            }
+        )
+    travel = np.array([row["travel"] for row in rows])
+    ratio = np.array([row["travel_ratio"] for row in rows])
+    return {
+        "rows": rows,
+        "spread": float((travel.max() - travel.min()) / travel.min()),
+        "ratio_spread": float((ratio.max() - ratio.min()) / ratio.min()),
+    }
+
+
+def odometry_study(quick: bool) -> dict:
+    """Coverage and travel on the room against heading / slip noise."""
+    levels = [(0.0, 0.0), (0.02, 0.0), (0.0, 0.1)] if quick else [
+        (0.0, 0.0), (0.005, 0.0), (0.01, 0.0), (0.02, 0.0), (0.05, 0.0),
+        (0.0, 0.05), (0.0, 0.1), (0.0, 0.2), (0.02, 0.1),
+    ]  # fmt: skip
+    seeds = range(2 if quick else 8)
+    rows = []
+    for heading_noise, slip_noise in levels:
+        env = _env(map_name="room", heading_noise=heading_noise, slip_noise=slip_noise)
+        runs = [_episode(env, "psa-cwa", s, max_steps=3000) for s in seeds]
+        rows.append(
+            {
+                "heading_noise": heading_noise,
+                "slip_noise": slip_noise,
+                "coverage": float(np.mean([r["coverage"] for r in runs])),
+                "coverage_min": float(np.min([r["coverage"] for r in runs])),
+                "travel": float(np.mean([r["travel"] for r in runs])),
+                "bumps": float(np.mean([r["bumps"] for r in runs])),
+                "all_swept": int(sum(r["is_success"] for r in runs)),
+                "episodes": len(runs),
+            }
+        )
+    return {"rows": rows, "max_steps": 3000}
+
+
+def weak_baseline_study(quick: bool) -> dict:
+    """Wall-following / least-swept-direction vs PSA + CWA on an empty 30 x 40 room."""
+    room = generator.empty_room(30, 40)
+    env = _env(grid=room)
+    seeds = range(2 if quick else 10)
+    rows = []
+    for s in seeds:
+        psa = _episode(env, "psa-cwa", s)
+        budget = _episode(env, "wall-follow", s, max_steps=psa["steps"])
+        final = _episode(env, "wall-follow", s, max_steps=5 * psa["steps"])
+        rows.append((psa, budget, final))
+    return {
+        "episodes": len(rows),
+        "psa_coverage": float(np.mean([p["coverage"] for p, _, _ in rows])),
+        "psa_travel_ratio": float(np.mean([p["travel_ratio"] for p, _, _ in rows])),
+        "psa_overlap": float(np.mean([p["overlap"] for p, _, _ in rows])),
+        "weak_coverage_same_steps": float(np.mean([b["coverage"] for _, b, _ in rows])),
+        "weak_coverage_5x_steps": float(np.mean([f["coverage"] for _, _, f in rows])),
+        "weak_overlap_same_steps": float(np.mean([b["overlap"] for _, b, _ in rows])),
+        "weak_travel_ratio_same_steps": float(np.mean([b["travel_ratio"] for _, b, _ in rows])),
+    }
+
+
+def _figures(out_dir: pathlib.Path, results: dict) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    files = []
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5))
+    for ax, name in zip(axes, maps.SHIPPED_MAPS, strict=True):
+        env = _env(map_name=name, render_mode="rgb_array", cell_pixels=6)
+        _episode(env, "psa-cwa", 0)
+        ax.imshow(env.render())
+        ax.set_title(f"{name}: PSA + CWA (paper Fig. {dict(room=10, apartment=13, maze=14)[name]})")
+        ax.axis("off")
+    fig.tight_layout()
+    files.append("sweeper_maps.png")
+    fig.savefig(out_dir / files[-1], dpi=100)
+    plt.close(fig)
+
+    sp = results["start_position"]
+    fig, ax = plt.subplots(figsize=(6, 6))
+    grid = maps.shipped_map("maze")
+    ax.imshow(np.where(grid, 0.0, 1.0), cmap="gray", vmin=0, vmax=1)
+    img = np.ma.masked_invalid(sp["image"])
+    im = ax.imshow(img, cmap="gray_r", interpolation="nearest")
+    fig.colorbar(im, ax=ax, label="travel (cells); darker = longer")
+    ax.set_title(f"travel per start cell (Fig. 15): spread {100 * sp['spread']:.1f} %")
+    files.append("sweeper_start_position.png")
+    fig.savefig(out_dir / files[-1], dpi=100)
+    plt.close(fig)
+
+    rows = results["orientation"]["rows"]
+    fig, ax1 = plt.subplots(figsize=(7, 4))
+    ax1.plot(
+        [r["angle"] for r in rows], [r["travel_ratio"] for r in rows], "o-", label="travel ratio"
+    )
+    ax1.set_xlabel("angle between walls and robot (deg)")
+    ax1.set_ylabel("travel / (area / W)")
+    ax2 = ax1.twinx()
+    ax2.plot([r["angle"] for r in rows], [100 * r["left_to_cwa"] for r in rows], "s--", color="C1")
+    ax2.set_ylabel("left unswept by PSA (%)", color="C1")
+    ax1.set_title("start orientation (Fig. 16-17)")
+    fig.tight_layout()
+    files.append("sweeper_orientation.png")
+    fig.savefig(out_dir / files[-1], dpi=100)
+    plt.close(fig)
+
+    rows = results["odometry"]["rows"]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    labels = [f"h{r['heading_noise']}/s{r['slip_noise']}" for r in rows]
+    ax.bar(labels, [100 * r["coverage"] for r in rows])
+    ax.set_ylabel("coverage (%)")
+    ax.set_title("odometry error (Fig. 20): heading rad / slip")
+    ax.tick_params(axis="x", rotation=45)
+    fig.tight_layout()
+    files.append("sweeper_odometry.png")
+    fig.savefig(out_dir / files[-1], dpi=100)
+    plt.close(fig)
+    return files
+
+
+def _print(results: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    t = Table(title="Sweeper: PSA + CWA coverage and travel (W = 3 cells)")
+    for col in ("map", "coverage min", "travel", "ratio mean / max", "SmartDFS ratio", "below"):
+        t.add_column(col)
+    for name, row in results["coverage"].items():
+        if name == "procedural":
+            continue
+        t.add_row(
+            name,
+            f"{100 * row['coverage_min']:.1f} %",
+            f"{row['travel_mean']:.0f}",
+            f"{row['travel_ratio_mean']:.2f} / {row['travel_ratio_max']:.2f}",
+            f"{row['smartdfs_ratio']:.2f}",
+            str(row["below_smartdfs"]),
+        )
+    p = results["coverage"]["procedural"]
+    t.add_row(
+        f"procedural x{p['episodes']}",
+        f"{100 * p['coverage_min']:.1f} % ({p['all_swept']} all swept)",
+        "",
+        f"{p['travel_ratio_mean']:.2f}",
+        "",
+        f"{p['below_smartdfs']}/{p['episodes']}",
+    )
+    console.print(t)
+    console.print("paper: full coverage of Fig. 6, 11 and 12 whatever the obstacles")
+
+    sp, ori, wk = results["start_position"], results["orientation"], results["weak_baseline"]
+    t = Table(title="Sensitivity and baseline: ours vs paper")
+    for col in ("measure", "ours", "paper"):
+        t.add_column(col)
+    t.add_row(
+        f"start position spread (maze, {sp['starts']} starts)",
+        f"{100 * sp['spread']:.1f} % ({sp['travel_min']:.0f}..{sp['travel_max']:.0f} cells)",
+        "3 % (20193..20843 base units)",
+    )
+    t.add_row(
+        f"start orientation spread ({len(ori['rows'])} angles)",
+        f"{100 * ori['spread']:.1f} % (ratio {100 * ori['ratio_spread']:.1f} %)",
+        "< 3 %",
+    )
+    t.add_row(
+        "weak baseline coverage, empty room",
+        f"{100 * wk['weak_coverage_same_steps']:.1f} % at PSA's steps, "
+        f"{100 * wk['weak_coverage_5x_steps']:.1f} % at 5x",
+        "about 90 %",
+    )
+    t.add_row(
+        "weak baseline overlap / PSA overlap",
+        f"{100 * wk['weak_overlap_same_steps']:.0f} % / {100 * wk['psa_overlap']:.0f} %",
+        "much overlap (Fig. 1)",
+    )
+    console.print(t)
+
+    t = Table(title="Odometry error on the room (paper: open problem, Fig. 20)")
+    for col in ("heading noise (rad/action)", "slip (rel.)", "coverage", "min", "travel", "bumps"):
+        t.add_column(col)
+    for r in results["odometry"]["rows"]:
+        t.add_row(
+            f"{r['heading_noise']}",
+            f"{r['slip_noise']}",
+            f"{100 * r['coverage']:.1f} %",
+            f"{100 * r['coverage_min']:.1f} %",
+            f"{r['travel']:.0f}",
+            f"{r['bumps']:.1f}",
+        )
+    console.print(t)
+
+
+def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
+    """Run every study, print ours beside the paper's, write JSON and figures."""
+    out_dir = pathlib.Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    results: dict[str, Any] = {"paper": PAPER, "robot_width": W, "quick": quick}
+    results["coverage"] = coverage_study(quick)
+    results["start_position"] = start_position_study(quick)
+    results["orientation"] = orientation_study(quick)
+    results["odometry"] = odometry_study(quick)
+    results["weak_baseline"] = weak_baseline_study(quick)
+    results["figures"] = _figures(out_dir, results)
+    results["wall_s"] = time.perf_counter() - t0
+    _print(results)
+    serialisable = json.loads(
+        json.dumps(
+            {
+                **results,
+                "start_position": {
+                    k: v for k, v in results["start_position"].items() if k != "image"
+                },
+            },
+            default=float,
+        )
+    )
+    (out_dir / "sweeper.json").write_text(json.dumps(serialisable, indent=2))
+    np.save(out_dir / "sweeper_start_travel.npy", results["start_position"]["image"])
+    return serialisable

@@ -1,0 +1,80 @@
+"""Run a sweeper policy for one episode: the entry point for studies and benchmarks.
+
+``sweep("maze", seed=0)`` makes ``motiongym/Sweeper-v0`` on the maze, runs
+PSA + CWA from the seeded start until every reachable cell is swept, and
+returns the final ``info`` (coverage, travel, overlap, turns, ...) with the
+wall time and the coverage reached when PSA handed over to CWA.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import gymnasium as gym
+
+from motiongym.baselines.policy import ScriptedPolicy
+
+POLICY_CLASSES = {
+    "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
+    "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
+}
+
+
+def make_policy(name: str, env: gym.Env, env_kwargs: dict[str, Any]) -> ScriptedPolicy:
+    """A sweeper policy by name (``psa-cwa`` or ``wall-follow``)."""
+    import importlib
+
+    if name not in POLICY_CLASSES:
+        raise ValueError(f"unknown sweeper policy {name!r}; choices: {', '.join(POLICY_CLASSES)}")
+    module, cls = POLICY_CLASSES[name].split(":")
+    return getattr(importlib.import_module(module), cls)(
+        env.observation_space, env.action_space, env_kwargs
+    )
+
+
+def run_episode(
+    env: gym.Env,
+    policy: ScriptedPolicy,
+    seed: int | None = None,
+    options: dict | None = None,
+    max_steps: int | None = None,
+) -> dict[str, Any]:
+    """One episode; returns the last ``info`` plus ``wall_s``, ``psa_coverage``, ``memory``."""
+    obs, info = env.reset(seed=seed, options=options)
+    memory = policy.new_memory()
+    psa_coverage = None
+    t0 = time.perf_counter()
+    steps = 0
+    while True:
+        action = policy.act(obs, memory)
+        mode = getattr(memory, "mode", "")
+        if psa_coverage is None and mode.startswith(("cwa", "done")):
+            psa_coverage = info["coverage"]
+        obs, _, terminated, truncated, info = env.step(action)
+        steps += 1
+        if terminated or truncated or (max_steps is not None and steps >= max_steps):
+            break
+    out = dict(info)
+    out["wall_s"] = time.perf_counter() - t0
+    out["psa_coverage"] = info["coverage"] if psa_coverage is None else psa_coverage
+    out["memory"] = memory
+    return out
+
+
+def sweep(
+    map_name: str = "maze",
+    seed: int | None = 0,
+    options: dict | None = None,
+    policy: str = "psa-cwa",
+    max_steps: int | None = None,
+    **env_kwargs: Any,
+) -> dict[str, Any]:
+    """Make ``Sweeper-v0`` with ``map_name`` and ``env_kwargs`` and run ``policy`` once."""
+    kwargs = {"map_name": map_name, **env_kwargs}
+    env = gym.make("motiongym/Sweeper-v0", **kwargs)
+    full_kwargs = {**gym.spec("motiongym/Sweeper-v0").kwargs, **kwargs}
+    try:
+        return run_episode(env, make_policy(policy, env, full_kwargs), seed, options, max_steps)
+    finally:
+        env.close()
