@@ -51,6 +51,16 @@ from motiongym.envs.excavator.kinematics import (
 )
 
 METHODS = ("newton", "lm")
+# The paper's case (section 5): bucket angle pi/8, tip at [15, 0, 0] in the
+# paper's units. Its Fig. 3 (the dimensions) is not in the text, so we put a
+# ground-level target on the x axis at 0.8 of our machine's maximum
+# ground-level reach (8.04 m: the far part of a trench stroke) and read the
+# bucket angle as a depression of pi/8 (tip 22.5 deg below the bucket pin,
+# beta = -pi/8): with beta = +pi/8 the bucket would have to open 96 deg past
+# the stick line, beyond the rotation range of a real bucket (the solver then
+# reports "joint_limits", tested).
+PAPER_REACH_FRACTION = 0.8
+PAPER_BETA = -math.pi / 8
 JACOBIANS = ("analytic", "numeric")
 _SINGULAR_COND = 1e12
 
@@ -66,6 +76,11 @@ class IKResult:
     errors: np.ndarray  # (iterations + 1, 5) V before each iteration and after the last
     position_error: float  # m
     angle_error: float  # rad
+
+
+def paper_target(m: Machine) -> tuple[np.ndarray, float]:
+    """The paper's case for machine ``m``: ``(tip (3,), beta)``, see :data:`PAPER_BETA`."""
+    return np.array([PAPER_REACH_FRACTION * m.reach, 0.0, 0.0]), PAPER_BETA
 
 
 def error_vector(q: np.ndarray, h_d: np.ndarray, m: Machine, base: np.ndarray | None = None):

@@ -1,0 +1,104 @@
+"""Excavator scripted policies: reach and dig cycle success rates; path generator; tracking."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from stable_baselines3.common.env_util import make_vec_env
+from stable_baselines3.common.evaluation import evaluate_policy
+
+import motiongym  # noqa: F401
+from motiongym.baselines.excavator import bucket_path as bp
+from motiongym.baselines.excavator.tracking import solve_pose, track
+from motiongym.baselines.registry import make_policy
+from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
+from motiongym.envs.excavator.kinematics import bucket_angle, forward
+
+
+def _episodes(env_id: str, name: str, seeds) -> list[dict]:
+    env = gym.make(env_id)
+    policy = make_policy(env_id, name, env.observation_space, env.action_space, {})
+    out = []
+    for seed in seeds:
+        obs, info = env.reset(seed=seed)
+        start, done, cost, min_pipe = True, False, 0.0, np.inf
+        while not done:
+            action, _ = policy.predict(obs, episode_start=start)
+            start = False
+            obs, _, terminated, truncated, info = env.step(action)
+            cost += info["cost"]
+            min_pipe = min(min_pipe, info["pipe_clearance"])
+            done = terminated or truncated
+        out.append({**info, "cost_sum": cost, "min_pipe": min_pipe})
+    return out
+
+
+def test_reach_policy_succeeds_on_every_scene():
+    results = _episodes("motiongym/ExcavatorReach-v0", "newton-raphson-reach", range(12))
+    assert all(r["is_success"] for r in results)
+    assert all(r["cost_sum"] == 0.0 for r in results)
+
+
+def test_dig_cycle_policy_delivers_without_touching_the_pipe():
+    results = _episodes("motiongym/Excavator-v0", "dig-cycle", range(6))
+    assert all(r["is_success"] for r in results)
+    assert all(r["pipe_contact"] == 0.0 and r["cost_sum"] == 0.0 for r in results)
+    assert all(r["min_pipe"] >= 0.5 for r in results)
+    assert np.mean([r["truck_soil"] for r in results]) >= 0.8 * M.bucket_capacity
+    assert all(r["spill"] <= 0.05 for r in results)
+    assert all(r["elapsed"] < 30.0 for r in results)
+
+
+def test_policies_work_through_sb3_vector_envs():
+    vec = make_vec_env("motiongym/ExcavatorReach-v0", n_envs=2, seed=0)
+    policy = make_policy(
+        "motiongym/ExcavatorReach-v0",
+        "newton-raphson-reach",
+        vec.observation_space,
+        vec.action_space,
+        {},
+    )
+    mean_reward, _ = evaluate_policy(policy, vec, n_eval_episodes=4)
+    assert mean_reward > 0.0
+
+
+def test_allowed_depth_keeps_the_bucket_above_a_pipe_under_the_zone():
+    zone = np.array([5.0, 0.0, 8.0, 0.0, 1.0])
+    under = np.array([6.5, -8.0, -2.0, 6.5, 8.0, -2.0, 0.15])  # crossing under the strip
+    depth = bp.allowed_depth(zone, under, M, safety=0.5)
+    lowest = -depth - M.link_radius[2]  # bucket capsule bottom at the cut depth
+    assert lowest - (-2.0 + 0.15) == pytest.approx(0.5 + bp.PIPE_MARGIN)
+    away = np.array([20.0, -8.0, -2.0, 20.0, 8.0, -2.0, 0.15])
+    assert bp.allowed_depth(zone, away, M, safety=0.5) == 1.0
+    deep = np.array([6.5, -8.0, -6.0, 6.5, 8.0, -6.0, 0.15])
+    assert bp.allowed_depth(zone, deep, M, safety=0.5) == 1.0
+
+
+def test_dig_path_follows_the_surface_at_the_cut_depth():
+    path = bp.dig_path(0.3, 5.0, 8.0, 0.7, lambda r: 0.1 * r)
+    drag = [w for w in path if w.phase == "drag"]
+    for w in drag:
+        r = np.hypot(w.tip[0], w.tip[1])
+        assert w.tip[2] == pytest.approx(0.1 * r - 0.7)
+        assert np.arctan2(w.tip[1], w.tip[0]) == pytest.approx(0.3)
+    assert np.hypot(*drag[-1].tip[:2]) == pytest.approx(5.0)
+    gaps = np.diff([np.hypot(*w.tip[:2]) for w in drag])
+    assert np.all(np.abs(gaps) <= bp.DRAG_STEP + 1e-9)
+
+
+def test_tracking_is_synchronised_and_dead_beat():
+    q, goal = np.zeros(4), np.array([0.5, -0.03, 0.02, 0.0])
+    a = track(q, goal, M, 0.1)
+    assert np.max(np.abs(a)) == pytest.approx(1.0)
+    step = a * np.array(M.rate_max) * 0.1
+    assert step / np.linalg.norm(step) == pytest.approx(goal / np.linalg.norm(goal))
+    small = np.array([0.01, 0.0, -0.02, 0.03])
+    np.testing.assert_allclose(track(q, small, M, 0.1) * np.array(M.rate_max) * 0.1, small)
+
+
+def test_solve_pose_handles_large_bucket_turns_near_90_degrees_of_swing():
+    q = np.array([1.8, 0.9, -1.5, 0.2])
+    h = forward(q, M)
+    result = solve_pose(h[:3, 3], bucket_angle(q), M, q_start=np.array([1.8, 0.9, -1.5, -2.0]))
+    assert result.converged
