@@ -43,8 +43,8 @@ class RobotMap:
         bump = bool(pose[3] > 0.5)
         o, R, S, w = self.off, self.R, self.S, self.w
         r0, c0 = r - R + o, c - R + o
-        self.occ[r0 : r0 + S, c0 : c0 + S] = np.asarray(obs["sensed"]) > 0.5
-        self.swept[r0 : r0 + S, c0 : c0 + S] |= np.asarray(obs["swept"]) > 0.5
+        self.occ[r0 : r0 + S, c0 : c0 + S] = np.asarray(obs["sensed"]).reshape(S, S) > 0.5
+        self.swept[r0 : r0 + S, c0 : c0 + S] |= np.asarray(obs["swept"]).reshape(S, S) > 0.5
         self.swept[r + o : r + o + w, c + o : c + o + w] = True
         self.lo = np.minimum(self.lo, (r0, c0))
         self.hi = np.maximum(self.hi, (r0 + S, c0 + S))

@@ -36,7 +36,7 @@ def turn_towards(heading: int, target: int) -> int:
 def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:
     """``(w, R)``: the robot width (from the env's keywords) and sensing range (window size)."""
     w = int(env_kwargs.get("robot_width", 3))
-    s = observation_space["sensed"].shape[0]
+    s = int(round(np.sqrt(observation_space["sensed"].shape[0])))
     return w, (s - w) // 2
 
 

@@ -36,22 +36,25 @@ class SweeperEnv(gym.Env):
     ## Observation space: ``Dict``
     With ``w = robot_width``, ``R = sensor_range``, ``S = w + 2R``, ``K = coarse``:
 
+    Windows and maps are flattened row-major (SB3's vector form); reshape
+    them to ``(S, S)`` and ``(K, K)``.
+
     ============= ======== ===================================================
     key           shape    meaning
     ============= ======== ===================================================
-    sensed        (S, S)   obstacles sensed around the footprint (1.0; outside
+    sensed        (S*S,)   obstacles sensed around the footprint (1.0; outside
                            the map counts as obstacle), world-aligned (row 0
                            north): entry ``[i, j]`` is map cell
                            ``(row - R + i, col - R + j)`` of the believed pose
-    swept         (S, S)   the robot's own sweep map over the same window
+    swept         (S*S,)   the robot's own sweep map over the same window
                            (1.0: swept)
     pose          (4,)     believed pose: footprint top-left row, column
                            (cells, map frame), heading (0 east, 1 north,
                            2 west, 3 south), bump on the last step (0/1)
-    sweep_map     (K, K)   the robot's built sweep map, coarse: each entry
+    sweep_map     (K*K,)   the robot's built sweep map, coarse: each entry
                            covers a ``ceil(H/K) x ceil(W/K)`` block of the
                            map and holds the fraction swept
-    obstacle_map  (K, K)   same blocks: fraction of known obstacle cells
+    obstacle_map  (K*K,)   same blocks: fraction of known obstacle cells
     ============= ======== ===================================================
 
     Everything is float32 in [0, 1] except ``pose`` (rows/columns up to 256).
@@ -168,8 +171,8 @@ class SweeperEnv(gym.Env):
 
         self.S = self.w + 2 * self.R
         side = float(maps.MAX_SIDE)
-        window = spaces.Box(0.0, 1.0, (self.S, self.S), np.float32)
-        coarse_map = spaces.Box(0.0, 1.0, (self.K, self.K), np.float32)
+        window = spaces.Box(0.0, 1.0, (self.S * self.S,), np.float32)
+        coarse_map = spaces.Box(0.0, 1.0, (self.K * self.K,), np.float32)
         self.observation_space = spaces.Dict(
             {
                 "sensed": window,
@@ -374,11 +377,11 @@ class SweeperEnv(gym.Env):
     def _obs(self, bump: bool) -> dict:
         S = self.S
         return {
-            "sensed": self.win.copy(),
-            "swept": self.bswept[self.br : self.br + S, self.bc : self.bc + S].copy(),
+            "sensed": self.win.flatten(),
+            "swept": self.bswept[self.br : self.br + S, self.bc : self.bc + S].flatten(),
             "pose": np.array([self.br, self.bc, self.h, float(bump)], np.float32),
-            "sweep_map": self.coarse_swept * self.inv_block,
-            "obstacle_map": self.coarse_obst * self.inv_block,
+            "sweep_map": (self.coarse_swept * self.inv_block).ravel(),
+            "obstacle_map": (self.coarse_obst * self.inv_block).ravel(),
         }
 
     def _info(self, r_sweep: float, r_time: float, r_bump: float, bump: bool) -> dict:

@@ -1,0 +1,194 @@
+"""motiongym/Sweeper-v0: API conformance, dynamics, reward terms, errors, odometry noise."""
+
+from __future__ import annotations
+
+import pickle
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import motiongym  # noqa: F401
+from motiongym.envs.sweeper.env import FORWARD, LEFT, RIGHT, SweeperEnv
+from motiongym.envs.sweeper.generator import empty_room
+
+ENV_ID = "motiongym/Sweeper-v0"
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [{}, {"map_name": "maze"}, {"map_name": "random"}, {"heading_noise": 0.05, "slip_noise": 0.1}],
+)
+def test_gymnasium_and_sb3_check_env(kwargs: dict) -> None:
+    from gymnasium.utils.env_checker import check_env
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    env = gym.make(ENV_ID, **kwargs)
+    check_env(env.unwrapped)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no SB3 warning about the spaces either
+        sb3_check_env(env.unwrapped)
+
+
+def test_make_without_import_and_spec_defaults() -> None:
+    env = gym.make("motiongym:motiongym/Sweeper-v0")
+    assert env.spec.max_episode_steps == 20_000
+    assert env.unwrapped.w == 3 and env.unwrapped.map_name == "room"
+
+
+def _run(env: gym.Env, actions, seed: int = 3, options=None):
+    obs, info = env.reset(seed=seed, options=options)
+    out = [(obs, 0.0, info)]
+    for a in actions:
+        obs, r, te, tr, info = env.step(a)
+        out.append((obs, r, info))
+        if te or tr:
+            break
+    return out
+
+
+def test_same_seed_same_episode_including_noise() -> None:
+    actions = np.random.default_rng(0).choice(3, size=300, p=[0.7, 0.15, 0.15])
+    for kwargs in ({"map_name": "random"}, {"heading_noise": 0.05, "slip_noise": 0.1}):
+        a = _run(gym.make(ENV_ID, **kwargs), actions)
+        b = _run(gym.make(ENV_ID, **kwargs), actions)
+        for (oa, ra, ia), (ob, rb, ib) in zip(a, b, strict=True):
+            assert ra == rb and ia == ib
+            for k in oa:
+                np.testing.assert_array_equal(oa[k], ob[k])
+
+
+def test_reward_terms_sum_and_info_keys() -> None:
+    env = gym.make(ENV_ID, map_name="apartment")
+    env.reset(seed=1)
+    measures = env.unwrapped.metadata["info_measures"]
+    assert set(measures.values()) <= {"last", "sum", "mean", "min", "max"}
+    rng = np.random.default_rng(1)
+    for _ in range(400):
+        _, r, te, tr, info = env.step(int(rng.choice(3, p=[0.7, 0.15, 0.15])))
+        assert r == pytest.approx(info["reward_sweep"] + info["reward_time"] + info["reward_bump"])
+        assert set(measures) <= set(info)
+        assert info["cost"] == (1.0 if info["reward_bump"] else 0.0)
+        assert isinstance(info["is_success"], bool)
+
+
+def test_forward_sweeps_a_new_row_and_bump_stays() -> None:
+    env = SweeperEnv(grid=empty_room(8, 10), robot_width=3, time_reward=-0.1)
+    obs, info = env.reset(seed=0, options={"start": (1, 1), "heading": 0})
+    assert info["coverage"] == pytest.approx(9 / 48)
+    obs, r, _, _, info = env.step(FORWARD)
+    assert (env.r, env.c) == (1, 2) and info["reward_sweep"] == pytest.approx(1.0)
+    assert r == pytest.approx(0.9) and info["travel"] == 1.0
+    for _ in range(4):
+        env.step(FORWARD)
+    assert (env.r, env.c) == (1, 6)  # the footprint touches the east wall
+    obs, r, _, _, info = env.step(FORWARD)
+    assert (env.r, env.c) == (1, 6) and info["cost"] == 1.0 and info["bumps"] == 1
+    assert obs["pose"][3] == 1.0 and r == pytest.approx(-1.1)
+    obs, _, _, _, info = env.step(LEFT)
+    assert obs["pose"][2] == 1 and info["turns"] == 1
+    obs, _, _, _, _ = env.step(RIGHT)
+    obs, _, _, _, _ = env.step(RIGHT)
+    assert obs["pose"][2] == 3  # south
+
+
+def test_sensed_window_and_maps() -> None:
+    env = SweeperEnv(grid=empty_room(8, 10), robot_width=2, sensor_range=1, coarse=4)
+    obs, _ = env.reset(seed=0, options={"start": (1, 1), "heading": 0})
+    assert obs["sensed"].shape == (16,) and obs["sweep_map"].shape == (16,)
+    sensed, swept = obs["sensed"].reshape(4, 4), obs["swept"].reshape(4, 4)
+    np.testing.assert_array_equal(sensed[0], 1.0)  # the north wall
+    np.testing.assert_array_equal(sensed[:, 0], 1.0)  # the west wall
+    assert sensed[1:, 1:].sum() == 0
+    np.testing.assert_array_equal(swept[1:3, 1:3], 1.0)
+    assert swept.sum() == 4
+    assert obs["sweep_map"].sum() > 0 and obs["obstacle_map"].sum() > 0
+    assert obs["pose"][:3].tolist() == [1, 1, 0]
+
+
+def test_terminates_when_all_reachable_swept() -> None:
+    env = SweeperEnv(grid=empty_room(5, 8), robot_width=3)  # one lane: 3 x 6 floor
+    env.reset(seed=0, options={"start": (1, 1), "heading": 0})
+    for k in range(3):
+        _, _, te, _, info = env.step(FORWARD)
+        assert te == (k == 2) and info["is_success"] == (k == 2)
+    assert info["coverage"] == 1.0 and info["travel_ratio"] == pytest.approx(3 * 3 / 18)
+
+
+def test_overlap_counts_cells_swept_twice() -> None:
+    env = SweeperEnv(grid=empty_room(5, 9), robot_width=3)
+    env.reset(seed=0, options={"start": (1, 1), "heading": 0})
+    env.step(FORWARD)
+    env.step(LEFT)
+    env.step(LEFT)
+    _, _, _, _, info = env.step(FORWARD)  # back west: the first column is entered again
+    assert info["overlap"] == pytest.approx(3 / 21)
+
+
+def test_reset_options_and_errors() -> None:
+    env = gym.make(ENV_ID)
+    obs, _ = env.reset(seed=0, options={"start": (5, 5), "heading": 2})
+    assert obs["pose"][:3].tolist() == [5, 5, 2]
+    with pytest.raises(ValueError, match="not a free configuration"):
+        env.reset(options={"start": (0, 0)})
+    with pytest.raises(ValueError, match="heading"):
+        env.reset(options={"heading": 7})
+    with pytest.raises(ValueError, match="unknown reset options"):
+        env.reset(options={"goal": 1})
+    with pytest.raises(ValueError, match="unknown map_name"):
+        SweeperEnv(map_name="castle")
+    with pytest.raises(FileNotFoundError):
+        SweeperEnv(map_file="/nonexistent/map.txt")
+    with pytest.raises(ValueError, match="robot_width"):
+        SweeperEnv(robot_width=0)
+    with pytest.raises(TypeError):
+        gym.make(ENV_ID, colour="red")
+
+
+@pytest.mark.parametrize("action", [np.array([0, 1]), np.nan, 3, -1, 1.5])
+def test_bad_actions_raise(action) -> None:
+    env = SweeperEnv()
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(action)
+
+
+def test_accepts_numpy_actions() -> None:
+    env = SweeperEnv()
+    env.reset(seed=0)
+    for a in (np.int64(1), np.array(2), np.array([0]), 0.0):
+        env.step(a)
+
+
+def test_odometry_noise_drifts_belief_but_counts_true_coverage() -> None:
+    env = SweeperEnv(map_name="room", heading_noise=0.05, slip_noise=0.2)
+    env.reset(seed=4)
+    rng = np.random.default_rng(4)
+    drift = 0
+    for _ in range(600):
+        env.step(int(rng.choice(3, p=[0.8, 0.1, 0.1])))
+        drift = max(drift, abs(env.r - env.br) + abs(env.c - env.bc))
+    assert drift >= 2
+    assert env.n_swept == int((env.sweeps > 0).sum())  # coverage from the true sweeps
+    assert ((env.sweeps > 0) <= env.scenario.reachable).all()
+    quiet = SweeperEnv(map_name="room")
+    quiet.reset(seed=4)
+    for _ in range(300):
+        quiet.step(int(rng.choice(3)))
+        assert (quiet.r, quiet.c) == (quiet.br, quiet.bc)
+
+
+def test_pickle_render_and_procedural_maps() -> None:
+    env = gym.make(ENV_ID, map_name="random", render_mode="rgb_array")
+    env.reset(seed=2)
+    env.step(0)
+    clone = pickle.loads(pickle.dumps(env))
+    img = clone.render()
+    h, w = clone.unwrapped.scenario.obstacle.shape
+    assert img.shape == (h * 8, w * 8, 3) and img.dtype == np.uint8
+    shapes = set()
+    for seed in range(6):
+        env.reset(seed=seed)
+        shapes.add(env.unwrapped.scenario.obstacle.shape)
+    assert len(shapes) > 1

@@ -1,0 +1,135 @@
+"""The sweeper's grid model, maps and procedural generator: known cases and brute force."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motiongym.envs.sweeper import generator, maps, world
+
+
+def brute_box_sum(image: np.ndarray, w: int) -> np.ndarray:
+    h, wd = image.shape
+    out = np.zeros((h, wd), np.int64)
+    for r in range(h):
+        for c in range(wd):
+            out[r, c] = image[r : r + w, c : c + w].sum()
+    return out
+
+
+@pytest.mark.parametrize("w", [1, 2, 3, 4])
+def test_box_sum_matches_brute_force(w: int) -> None:
+    image = np.random.default_rng(w).integers(0, 3, size=(9, 13))
+    np.testing.assert_array_equal(world.box_sum(image, w), brute_box_sum(image, w))
+
+
+def test_config_free_and_footprint_union_known_room() -> None:
+    grid = generator.empty_room(6, 7)  # 4 x 5 free floor
+    free = world.config_free(grid, 2)
+    assert free.sum() == 3 * 4  # anchors (1..3, 1..4)
+    assert free[1, 1] and free[3, 4] and not free[4, 4] and not free[0, 1]
+    cover = world.footprint_union(free, 2)
+    np.testing.assert_array_equal(cover, ~grid)
+
+
+def test_footprint_union_matches_brute_force() -> None:
+    configs = np.random.default_rng(0).random((10, 12)) < 0.1
+    w = 3
+    brute = np.zeros_like(configs)
+    for r, c in np.argwhere(configs):
+        brute[r : r + w, c : c + w] = True
+    np.testing.assert_array_equal(world.footprint_union(configs, w), brute)
+
+
+def test_reachable_cells_exclude_gaps_narrower_than_robot() -> None:
+    grid = generator.empty_room(10, 15)
+    grid[:, 7] = True
+    grid[4, 7] = False  # a one-cell door: a 3-wide robot cannot pass
+    reach = world.reachable_cells(grid, 3, (1, 1))
+    assert reach[1:9, 1:7].all() and not reach[:, 8:].any()
+    assert not reach[4, 7]  # the door cell itself cannot be swept
+
+
+def test_entering_mask() -> None:
+    east = world.entering_mask(0, 1, 3)
+    np.testing.assert_array_equal(east, np.array([[0, 0, 1]] * 3, bool))
+    assert world.entering_mask(1, 1, 3).sum() == 5
+    assert world.entering_mask(0, 0, 3).sum() == 0
+
+
+def test_smartdfs_bound_empty_room() -> None:
+    reach = np.ones((12, 18), bool)  # 12 x 18 floor: 4 x 6 blocks of 3 x 3
+    c, e, ratio = world.smartdfs_bound(reach, 3)
+    assert (c, e) == (24, 20)
+    assert ratio == pytest.approx(3 * (24 + 10) / (216 / 3))
+
+
+def test_bfs_distance_and_descend() -> None:
+    free = np.ones((5, 5), bool)
+    free[1:4, 2] = False
+    dist = world.bfs_distance(free, (2, 0))
+    assert dist[2, 4] == 8  # around the wall: up 2, across 4, down 2
+    path = world.descend(dist, (2, 4))
+    assert len(path) == 8 and path[-1] == (2, 4)
+    assert all(free[p] for p in path)
+
+
+def test_shipped_maps_sizes_and_closed() -> None:
+    shapes = {"room": (30, 40), "apartment": (40, 60), "maze": (48, 48)}
+    for name, shape in shapes.items():
+        grid = maps.shipped_map(name)
+        assert grid.shape == shape
+        assert world.is_closed(grid)
+        assert world.config_free(grid, 3).any()
+
+
+def test_map_errors(tmp_path) -> None:
+    with pytest.raises(maps.MapError, match="unknown map 'kitchen'"):
+        maps.shipped_map("kitchen")
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        maps.load_map_file(tmp_path / "none.txt")
+    (tmp_path / "open.txt").write_text("####\n#...\n####\n")
+    with pytest.raises(maps.MapError, match="not closed"):
+        maps.load_map_file(tmp_path / "open.txt")
+    (tmp_path / "full.txt").write_text("###\n###\n")
+    with pytest.raises(maps.MapError, match="no free cell"):
+        maps.load_map_file(tmp_path / "full.txt")
+    (tmp_path / "bad.txt").write_text("###\n#x#\n###\n")
+    with pytest.raises(maps.MapError, match="characters"):
+        maps.load_map_file(tmp_path / "bad.txt")
+    (tmp_path / "m.bmp").write_text("")
+    with pytest.raises(maps.MapError, match="unknown format"):
+        maps.load_map_file(tmp_path / "m.bmp")
+
+
+def test_png_and_text_round_trip(tmp_path) -> None:
+    from PIL import Image
+
+    grid = maps.shipped_map("room")
+    Image.fromarray(np.where(grid, 0, 255).astype(np.uint8)).save(tmp_path / "room.png")
+    np.testing.assert_array_equal(maps.load_map_file(tmp_path / "room.png"), grid)
+    (tmp_path / "room.txt").write_text(maps.to_text(grid))
+    np.testing.assert_array_equal(maps.load_map_file(tmp_path / "room.txt"), grid)
+
+
+@pytest.mark.parametrize("angle", [0, 30, 45, 90])
+def test_rotate_map_stays_closed(angle: float) -> None:
+    turned = maps.rotate_map(maps.shipped_map("maze"), angle)
+    assert world.is_closed(turned)
+    free_before = (~maps.shipped_map("maze")).sum()
+    assert abs((~turned).sum() - free_before) < 0.1 * free_before
+
+
+def test_generator_fifty_maps_closed_with_room_for_robot() -> None:
+    rng = np.random.default_rng(0)
+    kinds = set()
+    for _ in range(50):
+        kind = generator.KINDS[int(rng.integers(3))]
+        kinds.add(kind)
+        grid = generator.random_map(rng, 3, kind)
+        assert world.is_closed(grid)
+        assert world.config_free(grid, 3).sum() > 20
+        assert max(grid.shape) <= 64
+    assert kinds == set(generator.KINDS)
+    with pytest.raises(ValueError, match="unknown map kind"):
+        generator.random_map(rng, 3, "castle")
