@@ -13,8 +13,8 @@ bucket opening faces ``(sin beta, -cos beta)`` in the boom plane):
 * penetrate: down to the cut depth ``d`` 0.4 m inside the far end;
 * drag: toward the machine at ``surface(r) - d`` in 0.25 m steps, the bucket
   turning to ``beta = -1.75`` (opening toward the machine);
-* curl: bucket to ``beta_carry = -2.6`` (opening up), tip 0.3 m higher;
-* lift: tip straight up to 0.8 m above the surface;
+* curl: bucket to ``beta_carry = -2.6`` (opening up) about its pin;
+* lift: pin 0.5 m inwards and up until the tip is 0.8 m above the surface;
 * carry: bucket pin over the truck's near half at the carry height
   ``rim + L4 + bucket radius + 0.3 m`` (the opened bucket then clears the rim);
 * swing: the same pose at the truck's azimuth (only the swing joint moves);
@@ -106,12 +106,29 @@ def dig_path(
     return path
 
 
-def curl_lift_path(tip: np.ndarray, surface_here: float) -> list[Waypoint]:
-    """Curl in place (tip 0.3 m up), then lift straight up 0.8 m above the surface."""
+def curl_lift_path(tip: np.ndarray, beta: float, surface_here: float, m: Machine) -> list[Waypoint]:
+    """Curl about the bucket pin, then lift the pin 0.5 m inwards and up.
+
+    The pin (``tip - L4 [cos beta, sin beta]`` in the boom plane) stays put
+    while the bucket turns to ``beta_carry`` (the policy clips joint goals to
+    the joint ranges); then it moves 0.5 m toward the machine and up until
+    the tip is 0.8 m above the surface.
+    """
     x, y, z = (float(v) for v in tip)
+    r = math.hypot(x, y)
+    c, s = (x / r, y / r) if r > 1e-9 else (1.0, 0.0)
+    pin_r = r - m.L4 * math.cos(beta)
+    pin_z = z - m.L4 * math.sin(beta)
+
+    def tip_at(pr: float, pz: float, b: float) -> tuple[float, float, float]:
+        tr = pr + m.L4 * math.cos(b)
+        return (c * tr, s * tr, pz + m.L4 * math.sin(b))
+
+    lift_r = pin_r - 0.5
+    lift_z = max(pin_z + 0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY))
     return [
-        Waypoint("curl", (x, y, z + 0.3), BETA_CARRY),
-        Waypoint("lift", (x, y, max(z + 0.6, surface_here + 0.8)), BETA_CARRY),
+        Waypoint("curl", tip_at(pin_r, pin_z, BETA_CARRY), BETA_CARRY),
+        Waypoint("lift", tip_at(lift_r, lift_z, BETA_CARRY), BETA_CARRY),
     ]
 
 

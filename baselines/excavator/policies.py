@@ -41,7 +41,8 @@ class _ExcavatorPolicy(ScriptedPolicy):
 
     def _goal(self, wp: bp.Waypoint, q_start: np.ndarray) -> np.ndarray:
         result = solve_pose(np.array(wp.tip), wp.beta, self.m, q_start)
-        return result.q
+        # A pose beyond the limits is tracked as far as the joints go.
+        return np.clip(result.q, self.m.q_min, self.m.q_max)
 
     def _follow(self, q: np.ndarray, memory: dict) -> np.ndarray:
         """Track the memory's joint goals in order; hold the last one."""
@@ -127,8 +128,9 @@ class DigCyclePolicy(_ExcavatorPolicy):
             self._set(memory, "dig", bp.dig_path(azimuth, r_near, r_far, depth, surface)[1:], q)
         elif stage == "dig" and (fill >= 0.97 * self.m.bucket_capacity or self._done(q, memory)):
             tip = obs[self.lay["tip"]]
+            beta = float(obs[self.lay["bucket"]][0])
             here = memory["surface"](math.hypot(tip[0], tip[1]))
-            self._set(memory, "lift", bp.curl_lift_path(tip, here), q)
+            self._set(memory, "lift", bp.curl_lift_path(tip, beta, here, self.m), q)
         elif stage == "lift" and self._done(q, memory):
             waypoints, _ = bp.carry_dump_path(azimuth, obs[self.lay["truck"]], self.m)
             self._set(memory, "dump", waypoints, q)
