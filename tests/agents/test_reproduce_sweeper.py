@@ -1,0 +1,31 @@
+"""``motiongym reproduce sweeper`` in its quick form: numbers, files and the paper's shape."""
+
+from __future__ import annotations
+
+import json
+
+from motiongym.agents.reproduce.sweeper import run
+
+
+def test_reproduce_sweeper_quick(tmp_path, capsys) -> None:
+    results = run(tmp_path, quick=True)
+    printed = capsys.readouterr().out
+    assert "SmartDFS" in printed and "about 90 %" in printed and "3 %" in printed
+    saved = json.loads((tmp_path / "sweeper.json").read_text())
+    assert saved["coverage"]["maze"]["coverage_min"] == results["coverage"]["maze"]["coverage_min"]
+    for name in ("room", "apartment", "maze"):
+        assert results["coverage"][name]["coverage_min"] == 1.0  # the paper: full coverage
+    assert (
+        results["coverage"]["procedural"]["all_swept"]
+        == results["coverage"]["procedural"]["episodes"]
+    )
+    sp = results["start_position"]
+    assert sp["starts"] > 30 and 0.0 <= sp["spread"] < 1.0
+    assert all(row["coverage"] == 1.0 for row in results["orientation"]["rows"])
+    rows = results["odometry"]["rows"]
+    assert rows[0]["coverage"] == 1.0 and rows[0]["heading_noise"] == 0.0
+    assert min(r["coverage"] for r in rows[1:]) < 1.0  # noise costs coverage
+    wk = results["weak_baseline"]
+    assert wk["psa_coverage"] == 1.0 and wk["weak_coverage_same_steps"] < 1.0
+    for name in results["figures"]:
+        assert (tmp_path / name).stat().st_size > 1000

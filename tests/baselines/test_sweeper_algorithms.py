@@ -1,0 +1,118 @@
+"""The sweeper paper's algorithms on their own: quadtree transfer, PSA pieces, CWA scan."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motiongym.baselines.sweeper import cwa, psa, quadtree
+from motiongym.envs.sweeper import generator, maps, world
+
+
+def test_quadtree_leaves_tile_the_free_cells_exactly() -> None:
+    free = world.config_free(maps.shipped_map("apartment"), 3)
+    leaves, label = quadtree.decompose(free)
+    covered = np.zeros_like(free)
+    for r, c, s in leaves:
+        assert not covered[r : r + s, c : c + s].any()  # no overlap
+        covered[r : r + s, c : c + s] = True
+        assert s & (s - 1) == 0  # power-of-two squares
+    np.testing.assert_array_equal(covered, free)
+    np.testing.assert_array_equal(label >= 0, free)
+    assert len(leaves) < free.sum() / 2  # the decomposition merges big free squares
+
+
+@pytest.mark.parametrize("name", ["room", "apartment", "maze"])
+def test_quadtree_path_valid_complete_and_near_shortest(name: str) -> None:
+    free = world.config_free(maps.shipped_map(name), 3)
+    cells = np.argwhere(free)
+    rng = np.random.default_rng(1)
+    total_q = total_bfs = 0
+    for _ in range(30):
+        a = tuple(int(v) for v in cells[rng.integers(len(cells))])
+        b = tuple(int(v) for v in cells[rng.integers(len(cells))])
+        dist = world.bfs_distance(free, a)
+        path = quadtree.plan(free, a, b)
+        if dist[b] < 0:
+            assert path is None
+            continue
+        assert path is not None and (path[-1] == b or a == b)
+        for p, q in zip([a, *path[:-1]], path, strict=True):
+            assert abs(p[0] - q[0]) + abs(p[1] - q[1]) == 1 and free[q]
+        total_q += len(path)
+        total_bfs += dist[b]
+    assert total_q <= 1.1 * total_bfs
+
+
+def test_quadtree_no_path_between_separate_rooms() -> None:
+    grid = generator.empty_room(10, 21)
+    grid[:, 10] = True
+    free = world.config_free(grid, 3)
+    assert quadtree.plan(free, (1, 1), (1, 12)) is None
+
+
+def test_side_segments_one_width_beside_the_lane() -> None:
+    left, right = psa.side_segments((10, 5), (10, 15), 0, 3)  # a lane heading east
+    assert left == psa.Segment((7, 5), 0, 11, 1)  # north of it, pointing away north
+    assert right == psa.Segment((13, 5), 0, 11, 3)
+    rows, cols = psa.segment_configs(right)
+    assert rows.tolist() == [13] * 11 and cols.tolist() == list(range(5, 16))
+
+
+def test_first_target_skips_swept_and_takes_nearer_end() -> None:
+    seg = psa.Segment((0, 0), 0, 10, 3)
+    cfree = np.ones((3, 12), bool)
+    todo = np.zeros((3, 12), bool)
+    todo[0, 3:8] = True  # configurations 3..7 along the segment still cover unswept cells
+    assert psa.first_target(seg, (0, 0), cfree, todo) == ((0, 3), 0)
+    dist = np.abs(np.arange(12) - 11)[None, :].repeat(3, 0)  # robot at the east end
+    assert psa.first_target(seg, (0, 0), cfree, todo, dist) == ((0, 7), 2)
+    todo[:] = False
+    assert psa.first_target(seg, (0, 0), cfree, todo) is None  # the paper's skip
+
+
+def test_lane_open_and_stack_is_lifo() -> None:
+    occ = np.zeros((3, 3), np.int8)
+    assert psa.lane_open(occ, np.array([True, False, True]))
+    assert not psa.lane_open(occ, np.array([True, True, True]))  # nothing new ahead
+    occ[1, 2] = 1
+    assert not psa.lane_open(occ, np.array([False, False, False]))  # an obstacle ahead
+    stack = psa.PsaStack()
+    a, b = psa.Segment((0, 0), 0, 1, 1), psa.Segment((5, 5), 2, 3, 3)
+    stack.push(a)
+    stack.push(b)
+    assert stack.pop() == b and stack.pop() == a and len(stack) == 0
+
+
+def test_cwa_scan_order_top_right_to_bottom_left() -> None:
+    targets = np.zeros((8, 8), bool)
+    targets[1, 1] = targets[1, 6] = targets[6, 3] = True  # three separate leftovers
+    groups = cwa.scan_groups(targets)
+    assert [seed for seed, _ in groups] == [(1, 6), (1, 1), (6, 3)]
+    assert all(len(cells) == 1 for _, cells in groups)
+
+
+def test_cwa_groups_leftovers_by_obstacle_contour() -> None:
+    obstacle = generator.empty_room(10, 10)
+    obstacle[4:6, 4:6] = True  # a pillar
+    targets = np.zeros_like(obstacle)
+    targets[1, 1] = targets[8, 8] = True  # corners of the outer wall: one contour
+    targets[3, 4] = targets[6, 5] = True  # both sides of the pillar: another
+    groups = cwa.scan_groups(targets, obstacle, reach=1)
+    assert len(groups) == 2
+    sizes = sorted(len(cells) for _, cells in groups)
+    assert sizes == [2, 2]
+    assert groups[0][0] == (1, 1)  # the outer wall's first cell in scan order
+
+
+def test_cwa_leftovers_and_nearest_cover() -> None:
+    grid = generator.empty_room(7, 9)
+    occ = grid.astype(np.int8)
+    swept = np.zeros_like(grid)
+    swept[1:4, 1:8] = True  # one lane swept: rows 4-5 remain
+    free = world.config_free(grid, 3)
+    reach = world.reachable_configs(free, (1, 1))
+    left = cwa.leftovers(occ, swept, reach, 3)
+    assert left.sum() == 2 * 7 and left[4:6, 1:8].all()
+    dist = world.bfs_distance(free, (1, 1))
+    assert cwa.nearest_cover(dist, np.argwhere(left), 3) == (2, 1)  # one step south

@@ -1,0 +1,94 @@
+"""The sweeper's scripted policies: PSA + CWA sweeps everything; the weak baseline does not."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import motiongym  # noqa: F401
+from motiongym.baselines.registry import make_policy, scripted_policies
+from motiongym.baselines.sweeper.run import run_episode, sweep
+from motiongym.envs.sweeper.generator import empty_room
+
+ENV_ID = "motiongym/Sweeper-v0"
+
+
+def test_policies_declared() -> None:
+    assert set(scripted_policies(ENV_ID)) == {"psa-cwa", "wall-follow"}
+
+
+@pytest.mark.parametrize("map_name", ["room", "apartment", "maze"])
+def test_psa_cwa_sweeps_every_reachable_cell_of_the_paper_maps(map_name: str) -> None:
+    for seed in range(2):
+        info = sweep(map_name, seed=seed)
+        assert info["is_success"] and info["coverage"] == 1.0
+        assert info["bumps"] == 0  # it senses what is ahead
+        assert 1.0 <= info["travel_ratio"] < 2.5
+        assert info["psa_coverage"] > 0.9  # PSA does most of it, CWA the corners
+
+
+def _procedural(n: int, first_seed: int) -> None:
+    env = gym.make(ENV_ID, map_name="random")
+    kwargs = {**gym.spec(ENV_ID).kwargs, "map_name": "random"}
+    policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, kwargs)
+    for seed in range(first_seed, first_seed + n):
+        info = run_episode(env, policy, seed)
+        assert info["is_success"], (seed, info["coverage"])
+
+
+def test_psa_cwa_sweeps_procedural_maps() -> None:
+    _procedural(8, 0)
+
+
+@pytest.mark.slow
+def test_psa_cwa_sweeps_fifty_procedural_maps() -> None:
+    _procedural(50, 1000)
+
+
+def test_psa_cwa_through_sb3_predict_and_episode_start() -> None:
+    env = gym.make(ENV_ID, map_name="room")
+    policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, {})
+    for seed in (0, 1):  # two episodes: memory must be reset by episode_start
+        obs, _ = env.reset(seed=seed)
+        start = True
+        while True:
+            action, _ = policy.predict(obs, episode_start=np.array([start]))
+            start = False
+            obs, _, terminated, truncated, info = env.step(action)
+            if terminated or truncated:
+                break
+        assert info["is_success"]
+
+
+def test_psa_cwa_same_seed_same_trajectory() -> None:
+    a, b = sweep("maze", seed=5), sweep("maze", seed=5)
+    assert (a["travel"], a["turns"], a["steps"]) == (b["travel"], b["turns"], b["steps"])
+
+
+def test_psa_cwa_other_robot_widths_and_sensor_range() -> None:
+    for kwargs in ({"robot_width": 2}, {"robot_width": 4}, {"robot_width": 3, "sensor_range": 1}):
+        info = sweep("apartment", seed=0, **kwargs)
+        assert info["is_success"], kwargs
+
+
+def test_psa_cwa_user_map_from_grid() -> None:
+    grid = empty_room(20, 26)
+    grid[5:9, 6:20] = True
+    info = sweep("room", seed=0, grid=grid)
+    assert info["is_success"] and info["travel_ratio"] < 1.6
+
+
+def test_wall_follow_is_weaker_than_psa_on_the_empty_room() -> None:
+    room = empty_room(30, 40)
+    psa = sweep("room", seed=0, grid=room)
+    weak = sweep("room", seed=0, grid=room, policy="wall-follow", max_steps=psa["steps"])
+    assert psa["coverage"] == 1.0
+    assert 0.5 < weak["coverage"] < 1.0
+    assert weak["overlap"] > psa["overlap"]
+
+
+def test_psa_cwa_under_odometry_noise_keeps_sweeping() -> None:
+    info = sweep("room", seed=0, slip_noise=0.05, max_steps=3000)
+    assert info["coverage"] > 0.8
+    assert np.isfinite(info["travel"])
