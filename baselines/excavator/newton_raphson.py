@@ -29,6 +29,9 @@ refused otherwise) and reports whether it converged and, if not, why:
 * ``"singular"``: ``J^T J`` became singular (condition number above 1e12);
 * ``"max_iterations"``: none of the above, the iteration budget ran out.
 
+``H(q)`` is evaluated with the closed form of eq. 4
+(:func:`~motiongym.envs.excavator.kinematics.tip_frame`, equal to the matrix
+product, tested); the final pose is checked with the matrix product itself.
 Convergence is judged on the pose, not on ``V``: tip position error below
 ``tol_position`` (m) and bucket-angle error below ``tol_angle`` (rad), with
 the joint angles (wrapped to (-pi, pi]) inside the limits. A wrong pose is
@@ -47,6 +50,7 @@ from motiongym.envs.excavator.kinematics import (
     desired_pose,
     forward,
     swing_for_target,
+    tip_frame,
     tip_jacobian,
 )
 
@@ -83,10 +87,27 @@ def paper_target(m: Machine) -> tuple[np.ndarray, float]:
     return np.array([PAPER_REACH_FRACTION * m.reach, 0.0, 0.0]), PAPER_BETA
 
 
+def _frame(q: np.ndarray, m: Machine, base: np.ndarray | None) -> np.ndarray:
+    """``H(q)`` (eq. 5): the closed form of eq. 4, times the base pose if any."""
+    h = tip_frame(q, m)
+    return h if base is None else base @ h
+
+
+def _residual(q, h_d, m, base) -> tuple[np.ndarray, np.ndarray]:
+    h = _frame(q, m, base)
+    e = h - h_d
+    return np.array([e[0, 0], e[2, 0], e[0, 3], e[1, 3], e[2, 3]]), h
+
+
 def error_vector(q: np.ndarray, h_d: np.ndarray, m: Machine, base: np.ndarray | None = None):
     """``V`` of eq. 9 at ``q`` for the desired tip frame ``h_d``, shape (5,)."""
-    e = forward(q, m, base) - h_d
-    return np.array([e[0, 0], e[2, 0], e[0, 3], e[1, 3], e[2, 3]])
+    return _residual(q, h_d, m, base)[0]
+
+
+def _pose_errors(h: np.ndarray, h_d: np.ndarray) -> tuple[float, float]:
+    pos = float(np.linalg.norm(h[:3, 3] - h_d[:3, 3]))
+    cos_angle = float(np.clip(h[:3, 0] @ h_d[:3, 0], -1.0, 1.0))
+    return pos, math.acos(cos_angle)
 
 
 def jacobian(q: np.ndarray, m: Machine, base: np.ndarray | None = None) -> np.ndarray:
@@ -167,10 +188,7 @@ def _diagnose(tip, beta, m, base, singular: bool) -> str:
 
 def pose_errors(q: np.ndarray, h_d: np.ndarray, m: Machine, base=None) -> tuple[float, float]:
     """Tip position error (m) and bucket-axis angle error (rad) at ``q``."""
-    h = forward(q, m, base)
-    pos = float(np.linalg.norm(h[:3, 3] - h_d[:3, 3]))
-    cos_angle = float(np.clip(h[:3, 0] @ h_d[:3, 0], -1.0, 1.0))
-    return pos, math.acos(cos_angle)
+    return _pose_errors(forward(q, m, base), h_d)
 
 
 def solve(
@@ -214,7 +232,7 @@ def solve(
         raise ValueError(f"tip must be 3 finite numbers and beta finite, got {tip!r}, {beta!r}")
     h_d = desired_pose(tip, beta, m, base)
     q = np.array(m.q_rest if q0 is None else q0, float)
-    v = error_vector(q, h_d, m, base)
+    v, h = _residual(q, h_d, m, base)
     errors = [v]
     lam = damping
     lo, hi = np.array(m.q_min[1:]), np.array(m.q_max[1:])
@@ -228,26 +246,27 @@ def solve(
         )
         jtj = jac.T @ jac  # (4, 4)
         if method == "newton":
-            if np.linalg.cond(jtj) > _SINGULAR_COND:
+            eig = np.linalg.eigvalsh(jtj)  # ascending, J^T J is symmetric
+            if eig[0] <= eig[-1] / _SINGULAR_COND:
                 singular = True
                 k -= 1
                 break
             q = q - np.linalg.solve(jtj, jac.T @ v)  # eq. 11-13
-            v = error_vector(q, h_d, m, base)
+            v, h = _residual(q, h_d, m, base)
         else:
             while True:
                 q_try = q - np.linalg.solve(jtj + lam * np.eye(4), jac.T @ v)
-                v_try = error_vector(q_try, h_d, m, base)
+                v_try, h_try = _residual(q_try, h_d, m, base)
                 if v_try @ v_try < v @ v or lam > 1e8:
-                    q, v, lam = q_try, v_try, max(lam / 10.0, 1e-12)
+                    q, v, h, lam = q_try, v_try, h_try, max(lam / 10.0, 1e-12)
                     break
                 lam *= 10.0
         if clamp:
             q[1:] = np.clip(q[1:], lo, hi)
-            v = error_vector(q, h_d, m, base)
+            v, h = _residual(q, h_d, m, base)
         errors.append(v)
         if stop_early:
-            pos, ang = pose_errors(q, h_d, m, base)
+            pos, ang = _pose_errors(h, h_d)
             if pos < tol_position and ang < tol_angle:
                 break
     q = wrap(q)

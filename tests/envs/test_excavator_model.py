@@ -69,6 +69,7 @@ def test_scalar_chain_equals_matrix_product_and_base_pose_applies():
     for q in _random_q(rng, 50):
         h = kin.forward(q, M)
         assert kin.arm_points(*q, M)[3] == pytest.approx(tuple(h[:3, 3]), abs=1e-12)
+        np.testing.assert_allclose(kin.tip_frame(q, M), h, atol=1e-12)
         np.testing.assert_allclose(kin.forward(q, M, base), base @ h, atol=1e-12)
         # The bucket's x axis has elevation beta = q2 + q3 + q4.
         assert math.asin(h[2, 0]) == pytest.approx(
