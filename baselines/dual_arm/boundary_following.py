@@ -20,13 +20,18 @@ Paper section III (steps 1-3 and the two remarks after Fig. 4), on a lazy
    collision region, steps 2-3 are repeated from there, until it is clear.
 
 Our reading where the text is open, each documented and tested:
-* "The TLVST curve shifted to pass through a point" is ambiguous when the
-  curve runs along a level for several columns; we take the shift whose curve
-  *enters* the level at the point, ``D = s1 - a(s2)`` with ``a(s2)`` the first
-  column of the undelayed curve on level ``s2``. This is the smallest delay
-  whose curve stays right of a region cell on the point's left, i.e. exactly
-  the delay that makes the curve touch the region's right side, and it gives
-  the paper's ``k2 - k1``.
+* "From a candidate, proceed along the TLVST curve": the curve is shifted to
+  pass through the candidate *and leave it by the walk's own move* ("0" or
+  "1"), with the smallest such shift: for "1" the candidate is the last cell
+  of the curve's run on its level, ``D = s1 - b(s2)``; for "0" the one before
+  it, ``D = s1 - b(s2) + 1`` (``a(s2)``, ``b(s2)``: first and last column of
+  the undelayed curve on level ``s2``; the paper's ``k2 - k1`` with ``k1`` the
+  undelayed column at dp). Cells of the shifted curve behind the candidate
+  are what step 4 re-checks. The other reading, the curve *entering* the
+  candidate's level there (``D = s1 - a(s2)``, ``shift="enter"``), stops at
+  the first free curve along a region's lower edge, one or more samples late
+  where robot 2 climbs slower than one level per sample (18 of 80 sampled
+  pairs above the minimum, against 0 of 80 with "move").
 * Outside the map (``s1 < 0``, ``s2 < 0``, ``s2 > N_l``) is blocked; right of
   ``N1`` robot 1 rests, so columns repeat; right of ``N1 + N2`` (a delay past
   sequential operation) is blocked.
@@ -93,6 +98,7 @@ def _search(
     taken: set[tuple[int, int]],
     result: BoundaryResult,
     max_steps: int,
+    shift: str = "move",
 ) -> tuple[int, tuple[int, int] | None] | None:
     """Steps 1-3 from ``start`` on the curve delayed by ``delay``, to the curve's end.
 
@@ -122,7 +128,8 @@ def _search(
         if move in (0, 1) and (s1, s2) not in taken:
             taken.add((s1, s2))
             result.candidates.append((s1, s2))
-            departure, delay, mode = (s1, s2), cmap.departure_delay(s1, s2), "t"
+            along = move if shift == "move" else None
+            departure, delay, mode = (s1, s2), cmap.departure_delay(s1, s2, along), "t"
             continue
         state = (s1, s2, move)
         if seen.get(state) == len(taken):
@@ -137,7 +144,7 @@ def _search(
 
 
 def boundary_following(
-    cmap: CollisionMap, max_rounds: int = 20, max_steps: int | None = None
+    cmap: CollisionMap, max_rounds: int = 20, max_steps: int | None = None, shift: str = "move"
 ) -> BoundaryResult:
     """The paper's minimum-delay search; see the module docstring.
 
@@ -146,9 +153,13 @@ def boundary_following(
             and after, so a fresh map gives the method's own count.
         max_rounds: repetitions of step 4 before giving up.
         max_steps: bound on walk steps per round (default: 8 x the map's cells).
+        shift: how the TLVST curve is shifted through a candidate: "move" (our
+            reading, default) or "enter" (the alternative reading; see above).
     Returns:
         :class:`BoundaryResult`; ``delay * dt`` is the paper's TD.
     """
+    if shift not in ("move", "enter"):
+        raise ValueError(f"unknown shift {shift!r}; choose 'move' or 'enter'")
     before = cmap.evaluated
     steps = max_steps or 8 * (cmap.n1 + cmap.n2 + 2) * (cmap.n_levels + 1)
     result = BoundaryResult(delay=None, departure=None, evaluated=0)
@@ -159,7 +170,7 @@ def boundary_following(
     taken: set[tuple[int, int]] = set()
     start, delay, departure = (0, 0), 0, None
     for rounds in range(max_rounds + 1):
-        found = _search(cmap, start, delay, taken, result, steps)
+        found = _search(cmap, start, delay, taken, result, steps, shift)
         if found is None:
             break
         delay, dp = found

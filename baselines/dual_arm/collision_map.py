@@ -59,6 +59,8 @@ class CollisionMap:
         nxt = np.append(tl[1:], n_levels)
         self.first_col = np.searchsorted(nxt, np.arange(n_levels + 1), side="left")
         self.first_col[0] = 0
+        # last_col[s2]: the last column b(s2) of the undelayed curve at level s2.
+        self.last_col = np.searchsorted(tl, np.arange(n_levels + 1), side="right") - 1
 
     # ------------------------------------------------------------------ building
 
@@ -145,6 +147,17 @@ class CollisionMap:
             return 0
         return 1
 
-    def departure_delay(self, s1: int, s2: int) -> int:
-        """The delay whose curve enters level ``s2`` at column ``s1``: ``s1 - a(s2)``."""
-        return int(s1 - self.first_col[s2])
+    def departure_delay(self, s1: int, s2: int, move: int | None = None) -> int:
+        """The delay of the TLVST curve shifted to pass through ``(s1, s2)``.
+
+        Without ``move``: the curve that enters level ``s2`` at ``s1``,
+        ``s1 - a(s2)``. With ``move`` 0 or 1: the smallest delay whose curve
+        passes through the cell and leaves it by that move: for "1" the cell is
+        the last of the curve's run on its level, ``s1 - b(s2)``; for "0" the
+        one before, ``s1 - b(s2) + 1`` (never more than ``s1 - a(s2)``).
+        """
+        enter = int(s1 - self.first_col[s2])
+        if move is None:
+            return enter
+        last = int(s1 - self.last_col[s2])
+        return max(0, min(enter, last + 1 if move == 0 else last))

@@ -39,6 +39,11 @@ class SchedulePolicy(ScriptedPolicy):
         n_levels: ``N_l``, robot 2's length divisions on the map.
         plan_margin: extra clearance (m) the planner demands beyond the
             environment's ``safety_margin``.
+        verify: check the plan at the arms' actual samples
+            (``schedules.collides_at_samples``); where the map's length
+            discretisation hid a graze, plan again with the map's margin raised
+            by ``replan_step`` (m), at most ``max_replans`` times, then fall back
+            to sequential operation. The memory records ``margin`` and ``replans``.
     """
 
     def __init__(
@@ -48,12 +53,19 @@ class SchedulePolicy(ScriptedPolicy):
         env_kwargs: dict[str, Any] | None = None,
         n_levels: int = 100,
         plan_margin: float = 0.0,
+        verify: bool = True,
+        replan_step: float = 0.005,
+        max_replans: int = 10,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
         if action_space.shape not in ((1,), (2,)):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
-        self.margin = float(self.env_kwargs.get("safety_margin", 0.0)) + float(plan_margin)
+        self.safety_margin = float(self.env_kwargs.get("safety_margin", 0.0))
+        self.margin = self.safety_margin + float(plan_margin)
+        self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
+
+    verifiable = True  # False: the schedule is not meant to be collision free
 
     def new_memory(self) -> dict[str, Any]:
         return {"schedule": None, "map": None}
@@ -61,13 +73,24 @@ class SchedulePolicy(ScriptedPolicy):
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
         raise NotImplementedError
 
+    def _plan_verified(self, traj1, traj2, memory: dict[str, Any]) -> schedules.Schedule:
+        margin = self.margin
+        for replans in range(self.max_replans + 1):
+            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, margin)
+            plan = self.plan(cmap, memory)
+            memory.update(map=cmap, margin=margin, replans=replans)
+            if not (self.verify and self.verifiable) or not schedules.collides_at_samples(
+                traj1, traj2, plan.advances, self.safety_margin
+            ):
+                return plan
+            margin += self.replan_step
+        memory["fallback"] = True
+        return schedules.sequential(cmap)
+
     def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
         obs = np.asarray(observation, dtype=float)
         if memory["schedule"] is None:
-            traj1, traj2 = tasks_from_observation(obs)
-            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, self.margin)
-            memory["map"] = cmap
-            memory["schedule"] = self.plan(cmap, memory)
+            memory["schedule"] = self._plan_verified(*tasks_from_observation(obs), memory)
         step = int(round(float(obs[OBS["elapsed"]][0]) / DT))
         adv = memory["schedule"].advances
         a2 = float(adv[step]) if step < len(adv) else 1.0
@@ -113,6 +136,8 @@ class MinMakespanPolicy(SchedulePolicy):
 
 class UndelayedPolicy(SchedulePolicy):
     """Both arms start together and run at nominal speed (no coordination)."""
+
+    verifiable = False
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
         return schedules.delay_schedule(cmap, 0)

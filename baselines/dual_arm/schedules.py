@@ -12,6 +12,10 @@ delay ``D``, ``N1 + N2`` for sequential operation (the delay ``D = N1``).
 * :func:`exhaustive_min_delay`: the correctness reference for boundary
   following: the smallest ``D`` in ``0 .. N1 + N2`` whose delayed TLVST curve
   (paper Fig. 2, shifted right by ``D``) has no collision cell.
+* :func:`collides_at_samples`: a schedule checked at the arms' own 20 ms
+  samples rather than on the map, whose length axis places robot 2 at the
+  level configurations ``s2 * dl`` and not where it actually is at a sample:
+  the map can miss a graze by a few millimetres.
 * :func:`min_makespan`: robot 2 may pause and resume at any sample (advance 0
   or 1 per step, the environment's action set at its extremes): a shortest
   monotone path through the free cells by dynamic programming over
@@ -26,6 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
+from motiongym.envs.dual_arm import model
+from motiongym.envs.dual_arm.task import Trajectory
 
 
 @dataclass
@@ -122,3 +128,20 @@ def _backtrack(
             adv[x - 1], p = 1, p - 1
         # else robot 2 waited at p during step x - 1 (reach[x - 1, p] holds).
     return Schedule(adv, makespan, None)
+
+
+def sample_indices(advances: np.ndarray, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray]:
+    """Robot 1's and robot 2's sample index at every step of a schedule (incl. the start)."""
+    p2 = np.concatenate([[0], np.cumsum(advances)])
+    return np.minimum(np.arange(len(p2)), n1), np.minimum(p2, n2)
+
+
+def collides_at_samples(
+    traj1: Trajectory, traj2: Trajectory, advances: np.ndarray, margin: float = 0.0
+) -> bool:
+    """True iff ``d(R1, R2) <= margin`` at some step of the schedule, evaluated at the
+    arms' actual samples (what the environment sees), not at the map's length levels."""
+    p1, p2 = sample_indices(advances, traj1.n_samples, traj2.n_samples)
+    a1, b1 = model.link_segments(traj1.samples()[p1], model.base_transform(traj1.robot))
+    a2, b2 = model.link_segments(traj2.samples()[p2], model.base_transform(traj2.robot))
+    return bool(model.segments_collide(a1, b1, a2, b2, margin).any())

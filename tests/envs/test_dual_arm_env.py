@@ -7,6 +7,8 @@ import os
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import pickle
+import subprocess
+import sys
 
 import gymnasium as gym
 import numpy as np
@@ -114,12 +116,28 @@ def test_pickle_mid_episode():
     assert a[1] == b[1]
 
 
+_RENDER = """
+import gymnasium as gym, numpy as np, motiongym
+env = gym.make("motiongym/DualArmCell-v0", render_mode="rgb_array")
+env.reset(seed=0)
+frame = env.render()
+print(frame.shape, frame.dtype, float(frame.std()))
+env.close()
+"""
+
+
 def test_render_rgb_array():
-    env = gym.make(ID, render_mode="rgb_array")
-    env.reset(seed=0)
-    frame = env.render()
-    assert frame.shape == (480, 640, 3) and frame.dtype == np.uint8 and frame.std() > 5
-    env.close()
+    # In a fresh process: the GL backend is fixed when mujoco is first imported.
+    out = subprocess.run(
+        [sys.executable, "-c", _RENDER],
+        env={**os.environ, "MUJOCO_GL": "egl"},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0, out.stderr
+    dtype, std = out.stdout.split()[-2:]
+    assert "(480, 640, 3)" in out.stdout and dtype == "uint8" and float(std) > 5
 
 
 def test_pettingzoo_parallel_env():
