@@ -149,6 +149,10 @@ class HarvestArmEnv(gym.Env):
                 self._pair_slot[lg, og] = self._pair_slot[og, lg] = li * n_obstacles + k
         self._clear = np.full(len(links) * n_obstacles, DISTANCE_CLIP)  # (L*K,)
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
+        self._sites = self.index["point_sites"]
+        self._s_sin, self._s_cos = self._slices["sin_q"], self._slices["cos_q"]
+        self._s_qdot, self._s_points = self._slices["qdot"], self._slices["points"]
+        self._s_dist = self._slices["distances"]
         self._q = np.zeros(n)
         self._renderer: mujoco.Renderer | None = None
         self._path: list[np.ndarray] = []
@@ -271,8 +275,8 @@ class HarvestArmEnv(gym.Env):
 
     def _update(self, qdot: np.ndarray) -> None:
         """Pose, clearances and the per-step part of the observation."""
-        d, s, obs = self.data, self._slices, self._obs
-        d.qpos[:] = self._q
+        d, obs, q = self.data, self._obs, self._q
+        d.qpos[:] = q
         mujoco.mj_kinematics(self.model, d)
         mujoco.mj_collision(self.model, d)
         clear = self._clear
@@ -281,12 +285,12 @@ class HarvestArmEnv(gym.Env):
             geom = d.contact.geom  # (ncon, 2)
             np.minimum.at(clear, self._pair_slot[geom[:, 0], geom[:, 1]], d.contact.dist)
         self._min_d = float(clear.min())
-        obs[s["sin_q"]] = np.sin(self._q)
-        obs[s["cos_q"]] = np.cos(self._q)
-        obs[s["qdot"]] = qdot
-        points = d.site_xpos[self.index["point_sites"], : self.dim]
-        obs[s["points"]] = points.ravel()
-        obs[s["distances"]] = clear
+        obs[self._s_sin] = np.sin(q)
+        obs[self._s_cos] = np.cos(q)
+        obs[self._s_qdot] = qdot
+        points = d.site_xpos[self._sites, : self.dim]
+        obs[self._s_points] = points.ravel()
+        obs[self._s_dist] = clear
         self._gripper = points[-1]
 
     def _distance_to_fruit(self) -> float:
@@ -316,11 +320,11 @@ class HarvestArmEnv(gym.Env):
             self._renderer = mujoco.Renderer(self.model, self.height, self.width)
         camera = mujoco.MjvCamera()
         if self.spec_arm.planar:
-            camera.lookat[:] = (0.3, -0.15, 0.0)
-            camera.distance, camera.azimuth, camera.elevation = 2.3, 90.0, -90.0
+            camera.lookat[:] = (0.35, -0.15, 0.0)
+            camera.distance, camera.azimuth, camera.elevation = 1.7, 90.0, -90.0
         else:
-            camera.lookat[:] = (0.35, 0.0, 0.35)
-            camera.distance, camera.azimuth, camera.elevation = 2.0, 215.0, -25.0
+            camera.lookat[:] = (0.35, 0.0, 0.4)
+            camera.distance, camera.azimuth, camera.elevation = 1.7, 200.0, -20.0
         self._renderer.update_scene(self.data, camera=camera)
         scene = self._renderer.scene
         for p0, p1 in zip(self._path[:-1], self._path[1:], strict=False):

@@ -159,6 +159,8 @@ def build_model(
     s.option.gravity = [0.0, 0.0, 0.0]
     s.visual.global_.offwidth = 640
     s.visual.global_.offheight = 480
+    s.visual.headlight.ambient = [0.35, 0.35, 0.35]
+    s.visual.headlight.diffuse = [0.6, 0.6, 0.6]
     s.worldbody.add_light(pos=[0.5, -1.0, 2.5], dir=[-0.2, 0.4, -1.0], diffuse=[0.8, 0.8, 0.8])
     s.worldbody.add_geom(
         type=mujoco.mjtGeom.mjGEOM_PLANE,
