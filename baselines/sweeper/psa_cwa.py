@@ -62,6 +62,8 @@ class Memory:
 class PsaCwaPolicy(ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
+    pop_order = "lifo"
+    slide_back = False  # shift further back along the lane when blocked at its end
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
@@ -129,20 +131,42 @@ class PsaCwaPolicy(ScriptedPolicy):
         for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
             if self._strip_unswept(m, seg):
                 m.stack.push(seg)
-        s, k = m.run_side, 0  # step 4: shift one width to the run's side
+        # step 4: shift one width to the run's side, at the blocking point or,
+        # where the side is blocked there, at the nearest point back along the lane
+        s, back = m.run_side, (h + 2) % 4
+        lane_len = abs(r - m.lane_start[0]) + abs(c - m.lane_start[1])
+        plan = None
+        for j in range(0, lane_len + 1 if self.slide_back else 1):  # pragma: no branch
+            base = (r + j * int(DR[back]), c + j * int(DC[back]))
+            k = self._shift_length(m, base, s)
+            target = (base[0] + k * int(DR[s]), base[1] + k * int(DC[s]))
+            if k == 0 or not self._lane_has_work(m, target, back):
+                continue
+            if k == self.w or j == 0:
+                plan = (j, base, k)
+            if k == self.w:
+                break
+        if plan is None:
+            m.mode = "pop"
+            return None
+        j, base, k = plan
+        path = [(r + i * int(DR[back]), c + i * int(DC[back])) for i in range(1, j + 1)]
+        path += [(base[0] + i * int(DR[s]), base[1] + i * int(DC[s])) for i in range(1, k + 1)]
+        m.path = deque(path)
+        m.goal, m.run_heading, m.mode = path[-1], back, "shift"
+        return None
+
+    def _shift_length(self, m: Memory, base: tuple[int, int], side: int) -> int:
+        """How many cells (up to ``w``) the robot can shift sideways from ``base``."""
+        k = 0
         while k < self.w:
-            occ, _ = m.map.footprint(r + (k + 1) * int(DR[s]), c + (k + 1) * int(DC[s]))
+            occ, _ = m.map.footprint(
+                base[0] + (k + 1) * int(DR[side]), base[1] + (k + 1) * int(DC[side])
+            )
             if (occ == OBSTACLE).any():
                 break
             k += 1
-        back = (h + 2) % 4
-        target = (r + k * int(DR[s]), c + k * int(DC[s]))
-        if k > 0 and self._lane_has_work(m, target, back):
-            m.path = deque((r + i * int(DR[s]), c + i * int(DC[s])) for i in range(1, k + 1))
-            m.goal, m.run_heading, m.mode = target, back, "shift"
-            return None
-        m.mode = "pop"
-        return None
+        return k
 
     def _strip_unswept(self, m: Memory, seg: psa.Segment) -> bool:
         rr, cc = psa.segment_configs(seg)
@@ -174,6 +198,16 @@ class PsaCwaPolicy(ScriptedPolicy):
         origin, occ, swept, cfree, cur = self._known(m, r, c)
         dist = world.bfs_distance(cfree, cur)
         todo = psa.covers_unswept(occ, swept, self.w)
+        if self.pop_order == "nearest":
+            best, best_k = None, None
+            for k, seg in enumerate(m.stack.items):
+                found = psa.first_target(seg, origin, dist >= 0, todo, dist)
+                if found is not None:
+                    d = dist[found[0][0] - origin[0], found[0][1] - origin[1]]
+                    if best is None or d < best:
+                        best, best_k = d, k
+            if best_k is not None:
+                m.stack.items.append(m.stack.items.pop(best_k))
         while len(m.stack):
             seg = m.stack.pop()
             found = psa.first_target(seg, origin, dist >= 0, todo, dist)
