@@ -171,8 +171,9 @@ class ExcavatorBase(gym.Env):
             raise ValueError(
                 f"action must have shape (4,) (swing, boom, stick, bucket), got {a.shape}"
             )
-        if not np.isfinite(a).all():
-            raise ValueError(f"action must be finite, got {a.tolist()}")
+        values = a.tolist()
+        if not all(map(math.isfinite, values)):
+            raise ValueError(f"action must be finite, got {values}")
         if self.scene is None:
             raise RuntimeError("call reset() before step()")
         m, dt = self.m, self.dt
@@ -182,10 +183,9 @@ class ExcavatorBase(gym.Env):
             if depth > 0.0:
                 scale = speed_fraction(depth, m.bucket_width, m)
         q, qdot = self.q, self.qdot
-        for k, v in enumerate(a.tolist()):
-            rate = (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * m.rate_max[k] * scale
+        for k, v, rmax, lo, hi in zip(range(4), values, m.rate_max, m.q_min, m.q_max):
+            rate = (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * rmax * scale
             new = q[k] + rate * dt
-            lo, hi = m.q_min[k], m.q_max[k]
             if new < lo or new > hi:
                 new = lo if new < lo else hi
                 rate = (new - q[k]) / dt
@@ -211,11 +211,12 @@ class ExcavatorBase(gym.Env):
         self.tip = self.points[3]
         self.beta = self.q[1] + self.q[2] + self.q[3]
 
-    def _edge(self) -> tuple[np.ndarray, np.ndarray]:
+    def _edge(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """End points (x, y) of the cutting edge, across the boom plane at the tip."""
         half = 0.5 * self.m.bucket_width
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
         x, y = self.tip[0], self.tip[1]
-        return np.array([x + half * s1, y - half * c1]), np.array([x - half * s1, y + half * c1])
+        return (x + half * s1, y - half * c1), (x - half * s1, y + half * c1)
 
     def _carve_and_pour(self) -> None:
         m = self.m
@@ -274,10 +275,13 @@ class ExcavatorBase(gym.Env):
             self.pipe_clear = bound
         # Truck.
         lateral = [-s1 * (x - ox) + c1 * (y - oy) for x, y in self._truck_corners]
-        side = 0.0 if min(lateral) * max(lateral) <= 0.0 else min(map(abs, lateral))
-        along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
-        ahead = max(min(along) - rmax, rmin - max(along), 0.0)
-        bound = max(side, ahead, lowest - self.truck.height) - self._max_r
+        lo, hi = min(lateral), max(lateral)
+        side = 0.0 if lo * hi <= 0.0 else min(abs(lo), abs(hi))
+        bound = max(side, lowest - self.truck.height) - self._max_r
+        if bound < HORIZON:
+            along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
+            ahead = max(min(along) - rmax, rmin - max(along), 0.0)
+            bound = max(bound, ahead - self._max_r)
         if bound < HORIZON:
             starts, ends = np.array(pts[:3]), np.array(pts[1:])
             self.truck_clear = truck_clearance(

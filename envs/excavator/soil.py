@@ -104,7 +104,7 @@ class Terrain:
         """Lower the cells swept by the cutting edge; returns the volume taken (m3).
 
         Args:
-            edge0, edge1: the edge's end points ``(a, b)`` (each (2,) xy) at the
+            edge0, edge1: the edge's end points ``(a, b)`` (each xy, 2 floats) at the
                 previous and the current step.
             z0, z1: the edge's height at those steps (m).
             free_capacity: room left in the bucket (m3); the cut is scaled to it.
@@ -113,13 +113,14 @@ class Terrain:
         through (the depth of cut of the resistance model).
         """
         self.last_cut_depth = 0.0
-        a0, b0 = np.asarray(edge0[0]), np.asarray(edge0[1])
-        a1, b1 = np.asarray(edge1[0]), np.asarray(edge1[1])
         half = 0.5 * self.cell
-        n_u = int(math.ceil(math.dist(a1, b1) / half)) + 1
-        n_s = int(math.ceil(max(math.dist(a0, a1), math.dist(b0, b1)) / half)) + 1
-        u = np.linspace(0.0, 1.0, n_u)[None, :, None]
-        s = np.linspace(0.0, 1.0, n_s)[:, None, None]
+        n_u = int(math.ceil(math.dist(edge1[0], edge1[1]) / half)) + 1
+        travel = max(math.dist(edge0[0], edge1[0]), math.dist(edge0[1], edge1[1]))
+        n_s = int(math.ceil(travel / half)) + 1
+        a0, b0 = np.asarray(edge0[0], float), np.asarray(edge0[1], float)
+        a1, b1 = np.asarray(edge1[0], float), np.asarray(edge1[1], float)
+        u = (np.arange(n_u) / (n_u - 1))[None, :, None]  # (1, n_u, 1)
+        s = (np.arange(n_s) / max(n_s - 1, 1))[:, None, None]  # (n_s, 1, 1)
         start = a0 + u * (b0 - a0)
         pts = start + s * ((a1 + u * (b1 - a1)) - start)
         zs = np.repeat(z0 + s[:, 0, 0] * (z1 - z0), n_u)
