@@ -183,7 +183,8 @@ class ExcavatorBase(gym.Env):
             if depth > 0.0:
                 scale = speed_fraction(depth, m.bucket_width, m)
         q, qdot = self.q, self.qdot
-        for k, v, rmax, lo, hi in zip(range(4), values, m.rate_max, m.q_min, m.q_max):
+        limits = zip(range(4), values, m.rate_max, m.q_min, m.q_max, strict=True)
+        for k, v, rmax, lo, hi in limits:
             rate = (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * rmax * scale
             new = q[k] + rate * dt
             if new < lo or new > hi:
