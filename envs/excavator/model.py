@@ -45,8 +45,10 @@ def build_spec(m: Machine, with_world: bool = True) -> mujoco.MjSpec:
     """The machine (and, with ``with_world``, ground, pipe, truck, markers) as an MjSpec."""
     spec = mujoco.MjSpec()
     spec.modelname = "excavator"
+    spec.visual.headlight.ambient = [0.45, 0.45, 0.45]
+    spec.visual.headlight.diffuse = [0.5, 0.5, 0.5]
     world = spec.worldbody
-    world.add_light(pos=[0, 0, 30], dir=[0, 0, -1], diffuse=[0.8, 0.8, 0.8])
+    world.add_light(pos=[0, 0, 30], dir=[0, 0, -1], diffuse=[0.6, 0.6, 0.6])
     tracks = world.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[2.3, 1.6, 0.45])
     tracks.pos, tracks.rgba = [-m.L0, 0, 0.45], [0.2, 0.2, 0.2, 1]
     parent = world
@@ -86,7 +88,7 @@ def _add_world(spec: mujoco.MjSpec, m: Machine) -> None:
     field.userdata = list(np.full(nx * ny, -Z_MIN / (Z_MAX - Z_MIN)))
     ground = world.add_geom(name="ground", type=mujoco.mjtGeom.mjGEOM_HFIELD, hfieldname="ground")
     ground.pos = [GRID_ORIGIN[0] + nx * GRID_CELL / 2, GRID_ORIGIN[1] + ny * GRID_CELL / 2, Z_MIN]
-    ground.rgba = (0.55, 0.42, 0.28, 1)
+    ground.rgba = (0.6, 0.47, 0.32, 0.85)  # a little see-through: the pipe shows
     pipe = world.add_geom(name="pipe", type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.15, 0, 0])
     pipe.fromto, pipe.rgba = [0, 0, -2, 1, 0, -2], (0.1, 0.4, 0.9, 1)
     truck = world.add_geom(name="truck", type=mujoco.mjtGeom.mjGEOM_BOX, size=[2.5, 1.2, 1.4])
@@ -94,7 +96,7 @@ def _add_world(spec: mujoco.MjSpec, m: Machine) -> None:
     load = world.add_geom(name="truck_soil", type=mujoco.mjtGeom.mjGEOM_BOX, size=[2.4, 1.1, 0.01])
     load.rgba = (0.45, 0.3, 0.15, 1)
     zone = world.add_geom(name="zone", type=mujoco.mjtGeom.mjGEOM_BOX, size=[1, 0.6, 0.01])
-    zone.rgba = (1.0, 1.0, 1.0, 0.35)
+    zone.rgba = (1.0, 1.0, 1.0, 0.6)
     world.add_site(name="target", pos=[0, 0, -10], size=[0.15, 0, 0], rgba=[0.1, 0.9, 0.2, 0.8])
     for geom in (ground, pipe, truck, load, zone):
         geom.contype, geom.conaffinity = 0, 0
@@ -105,6 +107,8 @@ def build_model(m: Machine, with_world: bool = True) -> mujoco.MjModel:
     model = build_spec(m, with_world).compile()
     model.geom_contype[:] = 0
     model.geom_conaffinity[:] = 0
+    # The scene geoms are placed at render time: their frames are not the body's.
+    model.geom_sameframe[:] = 0
     return model
 
 
@@ -145,7 +149,7 @@ class SceneRenderer:
         model.geom_quat[g] = _quat_z(truck.yaw)
         g = self._geom("truck_soil")
         fill_height = env.truck_soil / (4 * 2.4 * 1.1) + 0.01
-        model.geom_pos[g] = [truck.cx, truck.cy, 1.4 + fill_height]
+        model.geom_pos[g] = [truck.cx, truck.cy, truck.height - 1.3 + fill_height]
         model.geom_size[g, 2] = fill_height
         model.geom_quat[g] = _quat_z(truck.yaw)
         g = self._geom("bucket_soil")
