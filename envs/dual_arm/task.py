@@ -162,7 +162,8 @@ def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, tuple
 
 
 def _check_pair(seg1: tuple, seg2: tuple, margin: float) -> tuple[bool, bool]:
-    """(collides when both start together, one after the other is collision free).
+    """(collides when both start together, one after the other is collision free);
+    the second is only computed when the first holds.
 
     One after the other: robot 1's whole path clears robot 2's start and robot
     2's whole path clears robot 1's end.
@@ -170,10 +171,18 @@ def _check_pair(seg1: tuple, seg2: tuple, margin: float) -> tuple[bool, bool]:
     (a1, b1), (a2, b2) = seg1, seg2
     n1, n2 = len(a1) - 1, len(a2) - 1
     k = np.arange(max(n1, n2) + 1)
-    i1 = np.concatenate([np.minimum(k, n1), np.arange(n1 + 1), np.full(n2 + 1, n1)])
-    i2 = np.concatenate([np.minimum(k, n2), np.zeros(n1 + 1, int), np.arange(n2 + 1)])
-    hit = model.segments_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin)
-    return bool(hit[: len(k)].any()), not bool(hit[len(k) :].any())
+    i1, i2 = np.minimum(k, n1), np.minimum(k, n2)
+    if not model.segments_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin).any():
+        return False, True  # sequential clearance not needed: rejected anyway
+    return True, _sequential_ok(seg1, seg2, margin)
+
+
+def _sequential_ok(seg1: tuple, seg2: tuple, margin: float) -> bool:
+    (a1, b1), (a2, b2) = seg1, seg2
+    n1, n2 = len(a1) - 1, len(a2) - 1
+    i1 = np.concatenate([np.arange(n1 + 1), np.full(n2 + 1, n1)])
+    i2 = np.concatenate([np.zeros(n1 + 1, int), np.arange(n2 + 1)])
+    return not bool(model.segments_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin).any())
 
 
 def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
@@ -186,7 +195,7 @@ def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
 def sequential_clear(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> bool:
     """Robot 1's path clears robot 2's start and robot 2's path clears robot 1's end."""
     seg = [_arm_geometry(t)[1:] for t in (traj1, traj2)]
-    return _check_pair(seg[0], seg[1], margin)[1]
+    return _sequential_ok(seg[0], seg[1], margin)
 
 
 def sample_pair(
