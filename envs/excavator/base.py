@@ -109,8 +109,13 @@ class ExcavatorBase(gym.Env):
         """``(reward terms, success, extra info)`` after the physics of a step."""
         raise NotImplementedError
 
-    def _task_obs(self, buf: np.ndarray) -> None:
-        """Write the task's slices of the observation into ``buf``."""
+    def _task_obs(self) -> tuple:
+        """The task's slices and the scene's (truck, pipe), in layout order.
+
+        ``self._obs`` holds the static ones (written at reset); by default
+        everything after the ground profile is static.
+        """
+        return (self._obs[self.layout["profile"].stop :],)
 
     # ----------------------------------------------------------------- reset
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -305,15 +310,10 @@ class ExcavatorBase(gym.Env):
         return self._profile_cache
 
     def _observation(self) -> np.ndarray:
-        buf = self._obs
-        buf[0:4] = self.q
-        buf[4:8] = self.qdot
-        buf[8:11] = self.tip
-        buf[11] = self.beta
-        buf[12] = self.fill
-        buf[13:37] = self._profile()
-        self._task_obs(buf)
-        return buf.astype(np.float32)  # inside the bounds by construction (tested)
+        """The layout of :mod:`.observation`; inside the bounds by construction (tested)."""
+        head = self.q + self.qdot + [self.tip[0], self.tip[1], self.tip[2], self.beta, self.fill]
+        parts = (head, self._profile(), *self._task_obs())
+        return np.concatenate(parts, dtype=np.float32)
 
     def _info(self, terms: dict[str, float], success: bool) -> dict[str, Any]:
         cost = (

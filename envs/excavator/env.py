@@ -231,8 +231,11 @@ class ExcavatorEnv(ExcavatorBase):
         self._last = (self.fill, self.truck_soil, self.spill)
         self.dig_fill = 0.0
 
-    def _task_obs(self, buf: np.ndarray) -> None:
-        buf[self.layout["truck_soil"].start] = self.truck_soil
+    def _task_obs(self) -> tuple:
+        lay = self.layout
+        zone = self._obs[lay["zone"]]
+        scene = self._obs[lay["truck"].start : lay["pipe"].stop]
+        return (zone, (self.truck_soil,), scene)
 
     def _task_step(self) -> tuple[dict[str, float], bool, dict[str, Any]]:
         w = self.weights

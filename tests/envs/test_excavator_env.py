@@ -165,3 +165,30 @@ def test_reach_success_terminates_with_the_bonus():
     assert terminated and info["is_success"]
     assert info["position_error"] < 1e-9 and info["angle_error"] < 1e-9
     assert info["reward_success"] == env.weights["success"]
+
+
+@pytest.mark.parametrize("env_id, task", [(IDS[0], "reach"), (IDS[1], "dig")])
+def test_observation_slices_match_the_state(env_id, task):
+    from motiongym.envs.excavator.observation import layout
+
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=2)
+    rng = np.random.default_rng(0)
+    for _ in range(30):
+        obs, *_ = env.step(rng.uniform(-1, 1, 4))
+    lay = layout(task)
+    assert obs.shape == env.observation_space.shape and obs.dtype == np.float32
+    np.testing.assert_allclose(obs[lay["q"]], env.q, atol=1e-6)
+    np.testing.assert_allclose(obs[lay["qdot"]], env.qdot, atol=1e-6)
+    np.testing.assert_allclose(obs[lay["tip"]], env.tip, atol=1e-5)
+    assert obs[lay["bucket"]][0] == pytest.approx(env.beta, abs=1e-6)
+    np.testing.assert_allclose(obs[lay["truck"]], env.truck.as_array(), atol=1e-5)
+    np.testing.assert_allclose(obs[lay["pipe"]], env.pipe.as_array(), atol=1e-5)
+    c, s = np.cos(env.q[0]), np.sin(env.q[0])
+    r = 1.0 + 0.4 * np.arange(24)
+    np.testing.assert_allclose(obs[lay["profile"]], env.terrain.heights_at(c * r, s * r), atol=0.2)
+    if task == "dig":
+        np.testing.assert_allclose(obs[lay["zone"]], env.scene.zone.as_array(), atol=1e-5)
+        assert obs[lay["truck_soil"]][0] == pytest.approx(env.truck_soil)
+    else:
+        np.testing.assert_allclose(obs[lay["target"]], env.scene.target, atol=1e-5)
