@@ -89,7 +89,7 @@ class HarvestArmEnv(gym.Env):
 
     def __init__(
         self,
-        dof: int = 7,
+        dof: int | None = None,  # default 5 planar, 7 spatial
         planar: bool = False,
         n_obstacles: int | None = None,  # default 8 planar, 10 spatial
         n_bars: int | None = None,  # default 0 planar, 3 spatial
@@ -107,7 +107,8 @@ class HarvestArmEnv(gym.Env):
         width: int = 480,
         height: int = 360,
     ) -> None:
-        self.spec_arm = arm_spec(int(dof), bool(planar))
+        dof = (5 if planar else 7) if dof is None else int(dof)
+        self.spec_arm = arm_spec(dof, bool(planar))
         n_obstacles = (8 if planar else 10) if n_obstacles is None else int(n_obstacles)
         n_bars = (0 if planar else 3) if n_bars is None else int(n_bars)
         if not 0 <= n_bars <= n_obstacles:

@@ -23,9 +23,10 @@ link's end (Fig. 7b). The rest are our documented choices:
 
 Links are capsules about the segments joining consecutive *joint points*
 (distinct joint positions, base to gripper). Kinematics come from
-``mj_kinematics``; positional Jacobians of the joint points are built from
-MuJoCo's joint anchors and axes, ``J[:, j] = a_j x (p - o_j)`` for every joint
-``j`` proximal to the point (zero columns beyond it).
+``mj_kinematics``; positional Jacobians of the joint points from
+``mj_jacSite`` (equal to ``J[:, j] = a_j x (p - o_j)`` for every joint ``j``
+proximal to the point, zero columns beyond it; both tested against finite
+differences).
 """
 
 from __future__ import annotations
@@ -288,6 +289,7 @@ class ArmKinematics:
                 chain.add(b)
                 b = int(self.model.body_parentid[b])
             self._moves[p] = [int(jb) in chain for jb in jnt_body]
+        self._jac = np.zeros((len(sites), 3, spec.dof))
 
     @property
     def n_points(self) -> int:
@@ -301,12 +303,22 @@ class ArmKinematics:
 
     def jacobians(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Points (P, dim) and their positional Jacobians (P, dim, n)."""
+        m, d = self.model, self.data
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        jac = self._jac  # (P, 3, n)
+        for i, site in enumerate(self.index["point_sites"]):
+            mujoco.mj_jacSite(m, d, jac[i], None, int(site))
+        points = d.site_xpos[self.index["point_sites"], : self.dim].copy()
+        return points, jac[:, : self.dim, :].copy()
+
+    def jacobians_from_axes(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The same from joint anchors and axes, ``J[:, j] = a_j x (p - o_j)`` (a check)."""
         self.data.qpos[:] = q
         mujoco.mj_kinematics(self.model, self.data)
         points = self.data.site_xpos[self.index["point_sites"]]  # (P, 3)
-        anchors = self.data.xanchor  # (n, 3)
-        axes = self.data.xaxis  # (n, 3)
-        arm = points[:, None, :] - anchors[None, :, :]  # (P, n, 3)
-        jac = np.cross(axes[None, :, :], arm) * self._moves[:, :, None]  # (P, n, 3)
+        arm = points[:, None, :] - self.data.xanchor[None, :, :]  # (P, n, 3)
+        jac = np.cross(self.data.xaxis[None, :, :], arm) * self._moves[:, :, None]  # (P, n, 3)
         jac = np.transpose(jac, (0, 2, 1))  # (P, 3, n)
         return points[:, : self.dim].copy(), jac[:, : self.dim, :].copy()

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.geometry import closest_points_between_segments
+from motiongym.envs.geometry import closest_point_on_segment, closest_points_between_segments
 from motiongym.envs.harvest_arm.model import REACH, ArmKinematics
 
 FRUIT_RADIUS = 0.035  # m
@@ -43,6 +43,7 @@ START_CLEARANCE = 0.05  # m, obstacles vs the arm's start pose
 FRUIT_CLEARANCE = 0.06  # m, obstacle surface vs fruit surface
 MIN_TRAVEL = 0.35  # m, fruit vs start gripper
 MAX_REACH = 0.8 * REACH  # m, fruit vs the arm's base (planar) or shoulder (spatial)
+_BATCH = 32  # candidate obstacles drawn at once
 CLUSTER = 0.3  # m, obstacle centres within +-CLUSTER of the fruit (per axis)
 
 PLANAR_BOX = np.array([[0.05, -0.6], [0.85, 0.2]])  # (2, 2): low, high (m)
@@ -109,12 +110,16 @@ def solve_ik(
     """
     q = np.array(q0, float)
     limits = kin.spec.limits
-    err = np.inf
+    err, best, stalled = np.inf, np.inf, 0
     for _ in range(iters):
         points, jac = kin.jacobians(q)
         e = target - points[-1]
         err = float(np.linalg.norm(e))
         if err < 1e-4:
+            break
+        stalled = stalled + 1 if err > 0.98 * best else 0
+        best = min(best, err)
+        if stalled >= 8:  # no progress: at a joint limit or out of reach
             break
         j = jac[-1]  # (dim, n)
         step = j.T @ np.linalg.solve(j @ j.T + 1e-3 * np.eye(len(e)), e)
@@ -155,30 +160,40 @@ def sample_scene(
             break
     else:  # pragma: no cover - the fruit box lies well inside the reach
         raise RuntimeError("no reachable fruit found in 200 draws")
-    a = np.zeros((n_obstacles, dim))
-    b = np.zeros((n_obstacles, dim))
-    radius = np.zeros(n_obstacles)
-    is_bar = np.arange(n_obstacles) >= n_obstacles - n_bars
-    for k in range(n_obstacles):
-        for _ in range(1000):
-            centre = rng.uniform(
-                np.maximum(box[0], fruit - CLUSTER), np.minimum(box[1], fruit + CLUSTER)
-            )
-            if is_bar[k]:
-                direction = rng.normal(size=dim)
-                direction /= np.linalg.norm(direction)
-                half = 0.5 * rng.uniform(*BAR_LENGTH) * direction
-                a[k], b[k], radius[k] = centre - half, centre + half, BAR_RADIUS
+    low, high = np.maximum(box[0], fruit - CLUSTER), np.minimum(box[1], fruit + CLUSTER)
+    parts = []
+    for count, bars in ((n_obstacles - n_bars, False), (n_bars, True)):
+        found: list[Scene] = []
+        n_found = 0
+        for _ in range(100):  # batches of candidates, the first valid ones kept in draw order
+            if n_found >= count:
+                break
+            centre = rng.uniform(low, high, size=(_BATCH, dim))
+            if bars:
+                direction = rng.normal(size=(_BATCH, dim))
+                direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+                half = 0.5 * rng.uniform(*BAR_LENGTH, size=(_BATCH, 1)) * direction
+                cand = Scene(
+                    fruit, centre - half, centre + half, np.full(_BATCH, BAR_RADIUS),
+                    np.ones(_BATCH, bool),
+                )  # fmt: skip
             else:
-                a[k] = b[k] = centre
-                radius[k] = rng.uniform(*SPHERE_RADIUS)
-            one = Scene(fruit, a[k : k + 1], b[k : k + 1], radius[k : k + 1], is_bar[k : k + 1])
-            if clearance_to_arm(start, link_radius, one)[0] < START_CLEARANCE:
-                continue
-            fruit_gap = closest_points_between_segments(fruit, fruit, a[k], b[k])[0]
-            if fruit_gap - radius[k] - FRUIT_RADIUS < FRUIT_CLEARANCE:
-                continue
-            break
+                r = rng.uniform(*SPHERE_RADIUS, size=_BATCH)
+                cand = Scene(fruit, centre, centre.copy(), r, np.zeros(_BATCH, bool))
+            fruit_gap = closest_point_on_segment(fruit, cand.a, cand.b)[0] - cand.radius
+            ok = (clearance_to_arm(start, link_radius, cand) >= START_CLEARANCE) & (
+                fruit_gap - FRUIT_RADIUS >= FRUIT_CLEARANCE
+            )
+            keep = np.flatnonzero(ok)[: count - n_found]
+            found.append(
+                Scene(fruit, cand.a[keep], cand.b[keep], cand.radius[keep], cand.is_bar[keep])
+            )
+            n_found += len(keep)
         else:  # pragma: no cover - the box is far larger than the exclusions
-            raise RuntimeError("could not place an obstacle in 1000 draws")
+            raise RuntimeError("could not place the obstacles in 100 batches")
+        parts.extend(found)
+    a = np.concatenate([p.a for p in parts]).reshape(-1, dim)
+    b = np.concatenate([p.b for p in parts]).reshape(-1, dim)
+    radius = np.concatenate([p.radius for p in parts])
+    is_bar = np.concatenate([p.is_bar for p in parts])
     return Scene(fruit, a, b, radius, is_bar)

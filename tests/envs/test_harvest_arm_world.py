@@ -56,6 +56,7 @@ def test_point_jacobians_match_finite_differences(planar, dof):
     for _ in range(3):
         q = rng.uniform(-0.8, 0.8, dof) * spec.limits
         _, jac = kin.jacobians(q)  # (P, dim, n)
+        np.testing.assert_allclose(kin.jacobians_from_axes(q)[1], jac, atol=1e-12)
         numeric = np.zeros_like(jac)
         for j in range(dof):
             dq = np.zeros(dof)
