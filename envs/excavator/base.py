@@ -109,13 +109,8 @@ class ExcavatorBase(gym.Env):
         """``(reward terms, success, extra info)`` after the physics of a step."""
         raise NotImplementedError
 
-    def _task_obs(self) -> tuple:
-        """The task's slices and the scene's (truck, pipe), in layout order.
-
-        ``self._obs`` holds the static ones (written at reset); by default
-        everything after the ground profile is static.
-        """
-        return (self._obs[self.layout["profile"].stop :],)
+    def _task_obs(self, buf: np.ndarray) -> None:
+        """Write the task's changing slices into ``buf`` (static ones are set at reset)."""
 
     # ----------------------------------------------------------------- reset
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -158,7 +153,7 @@ class ExcavatorBase(gym.Env):
         self._profile_key = None
         self._profile_table = profile_table(self.m.L0, self.m.d2)
         self._flat_heights = self.terrain.h.reshape(-1)  # a view, follows the carving
-        self._obs = np.zeros(self.observation_space.shape, dtype=np.float64)
+        self._obs = np.zeros(self.observation_space.shape, dtype=np.float32)
         self._obs[self.layout["truck"]] = self.truck.as_array()
         self._obs[self.layout["pipe"]] = self.pipe.as_array()
         self._forward()
@@ -310,10 +305,15 @@ class ExcavatorBase(gym.Env):
         return self._profile_cache
 
     def _observation(self) -> np.ndarray:
-        """The layout of :mod:`.observation`; inside the bounds by construction (tested)."""
-        head = self.q + self.qdot + [self.tip[0], self.tip[1], self.tip[2], self.beta, self.fill]
-        parts = (head, self._profile(), *self._task_obs())
-        return np.concatenate(parts, dtype=np.float32)
+        """The layout of :mod:`.observation`; inside the bounds by construction (tested).
+
+        The static slices (task, truck, pipe) are written once at reset.
+        """
+        buf = self._obs
+        buf[0:13] = self.q + self.qdot + [*self.tip, self.beta, self.fill]
+        buf[13:37] = self._profile()
+        self._task_obs(buf)
+        return buf.copy()
 
     def _info(self, terms: dict[str, float], success: bool) -> dict[str, Any]:
         cost = (

@@ -10,11 +10,13 @@ of that class (Caterpillar 320 / Komatsu PC210 / Volvo EC220 brochures):
   Skibniewski (1993), the paper's kinematic reference;
 * boom-foot pin about 2.0 m above the ground, 0.15 m ahead of the swing axis
   (``L1``), swing axis on the track centre (``L0 = 0``), boom centred (``d2 = 0``);
-  this gives a maximum ground-level reach of about 10.2 m and a maximum
-  digging depth of about 6.7 m, the spec-sheet values of the class;
+  this gives a maximum ground-level reach of 10.05 m (joint limits ignored;
+  9.7 m within them), a maximum digging depth of 6.7 m and a cutting height
+  of 10.5 m, close to the spec-sheet values of the class (9.9 m, 6.7 m,
+  9.5 m);
 * joint ranges chosen to reproduce those envelopes (boom -50 deg to +69 deg
   from horizontal, stick folded 30 deg to 155 deg under the boom, bucket
-  rotation about 190 deg);
+  rotation 183 deg);
 * hydraulic joint-rate limits: swing 11 rpm (1.15 rad/s, spec sheets give
   11-12 rpm); boom, stick and bucket rates from the cylinder speeds behind the
   class's typical 2.5-3.5 s single-function times (0.6, 0.7, 1.0 rad/s);

@@ -228,14 +228,12 @@ class ExcavatorEnv(ExcavatorBase):
 
     def _task_reset(self) -> None:
         self._obs[self.layout["zone"]] = self.scene.zone.as_array()
+        self._soil_index = self.layout["truck_soil"].start
         self._last = (self.fill, self.truck_soil, self.spill)
         self.dig_fill = 0.0
 
-    def _task_obs(self) -> tuple:
-        lay = self.layout
-        zone = self._obs[lay["zone"]]
-        scene = self._obs[lay["truck"].start : lay["pipe"].stop]
-        return (zone, (self.truck_soil,), scene)
+    def _task_obs(self, buf: np.ndarray) -> None:
+        buf[self._soil_index] = self.truck_soil
 
     def _task_step(self) -> tuple[dict[str, float], bool, dict[str, Any]]:
         w = self.weights

@@ -142,8 +142,8 @@ def test_carving_a_strip_removes_its_volume_and_conserves_soil():
     edge1 = (np.array([1.0, -0.6]), np.array([1.0, 0.6]))
     before = t.volume()
     removed = t.carve(edge0, edge1, -0.5, -0.5, free_capacity=10.0)
-    # A 1.2 m x 1.0 m strip 0.5 m deep, to within the cell discretisation.
-    assert removed == pytest.approx(0.6, rel=0.15)
+    # A 1.2 m x 1.0 m strip 0.5 m deep: 12 x 10 cells of 0.1 m.
+    assert removed == pytest.approx(0.6, rel=1e-9)
     assert before - t.volume() == pytest.approx(removed, abs=1e-9)
     assert t.h.min() == pytest.approx(-0.5)
     assert t.carve(edge0, edge1, -0.5, -0.5, free_capacity=10.0) == 0.0  # already cut
