@@ -148,18 +148,21 @@ def sample_scene(
     dim = kin.dim
     home = np.array(kin.spec.home)
     start = kin.forward(home)  # (P, dim)
-    for _ in range(200):
-        fruit = rng.uniform(fruit_box[0], fruit_box[1])
-        root = start[0] if planar else start[1]
-        if (
-            np.linalg.norm(fruit - start[-1]) < MIN_TRAVEL
-            or np.linalg.norm(fruit - root) > MAX_REACH
-        ):
-            continue
-        if solve_ik(kin, fruit, home)[1] < 2e-3:
+    root = start[0] if planar else start[1]
+    fruit = None
+    for _ in range(20):  # batches of candidates; the first reachable one in draw order
+        cand = rng.uniform(fruit_box[0], fruit_box[1], size=(_BATCH, dim))
+        ok = (np.linalg.norm(cand - start[-1], axis=1) >= MIN_TRAVEL) & (
+            np.linalg.norm(cand - root, axis=1) <= MAX_REACH
+        )
+        for c in cand[ok]:
+            if solve_ik(kin, c, home)[1] < 2e-3:
+                fruit = c
+                break
+        if fruit is not None:
             break
     else:  # pragma: no cover - the fruit box lies well inside the reach
-        raise RuntimeError("no reachable fruit found in 200 draws")
+        raise RuntimeError("no reachable fruit found in 20 batches")
     low, high = np.maximum(box[0], fruit - CLUSTER), np.minimum(box[1], fruit + CLUSTER)
     parts = []
     for count, bars in ((n_obstacles - n_bars, False), (n_bars, True)):
