@@ -127,11 +127,12 @@ def _search(
             result.reason = f"enclosed at {(s1, s2)}"
             return None
         if move in (0, 1) and (s1, s2) not in taken:
-            taken.add((s1, s2))
-            result.candidates.append((s1, s2))
-            along = move if shift == "move" else None
-            departure, delay, mode = (s1, s2), cmap.departure_delay(s1, s2, along), "t"
-            continue
+            shifted = cmap.departure_delay(s1, s2, move if shift == "move" else None)
+            if shifted is not None:  # else left of the undelayed curve: no delay fits
+                taken.add((s1, s2))
+                result.candidates.append((s1, s2))
+                departure, delay, mode = (s1, s2), shifted, "t"
+                continue
         state = (s1, s2, move)
         if seen.get(state) == len(taken):
             result.reason = f"boundary walk cycles at {(s1, s2)} with no new candidate"

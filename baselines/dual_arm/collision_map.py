@@ -147,16 +147,20 @@ class CollisionMap:
             return 0
         return 1
 
-    def departure_delay(self, s1: int, s2: int, move: int | None = None) -> int:
+    def departure_delay(self, s1: int, s2: int, move: int | None = None) -> int | None:
         """The delay of the TLVST curve shifted to pass through ``(s1, s2)``.
 
         Without ``move``: the curve that enters level ``s2`` at ``s1``,
         ``s1 - a(s2)``. With ``move`` 0 or 1: the smallest delay whose curve
         passes through the cell and leaves it by that move: for "1" the cell is
         the last of the curve's run on its level, ``s1 - b(s2)``; for "0" the
-        one before, ``s1 - b(s2) + 1`` (never more than ``s1 - a(s2)``).
+        one before, ``s1 - b(s2) + 1`` (never more than ``s1 - a(s2)``, never
+        below 0). None if no delay >= 0 passes through the cell (it lies left
+        of the undelayed curve).
         """
         enter = int(s1 - self.first_col[s2])
+        if enter < 0:
+            return None
         if move is None:
             return enter
         last = int(s1 - self.last_col[s2])

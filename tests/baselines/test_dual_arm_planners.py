@@ -118,3 +118,24 @@ def test_sampled_pairs_sound_and_ordered(seed):
     best = schedules.min_makespan(full)
     assert schedules.schedule_is_free(full, best.advances)
     assert best.makespan <= full.end_column(exhaustive) <= full.n1 + full.n2
+
+
+def test_random_maps_equal_the_exhaustive_minimum():
+    # Random unions of rectangles (concave regions, several regions, walls) on random
+    # TLVST curves: boundary following is sound, fails only where no delay exists,
+    # and otherwise finds the exhaustive minimum.
+    rng = np.random.default_rng(0)
+    outcomes = {"agree": 0, "none": 0}
+    for _ in range(300):
+        n1, n_levels, n2 = (int(v) for v in rng.integers((20, 10, 10), (60, 30, 40)))
+        tl = np.sort(rng.integers(0, n_levels + 1, n2 + 1))
+        tl[0], tl[-1] = 0, n_levels
+        occ = np.zeros((n1 + 1, n_levels + 1), dtype=bool)
+        for _ in range(rng.integers(1, 15)):
+            x0, y0 = rng.integers(0, n1), rng.integers(1, n_levels)
+            occ[x0 : x0 + rng.integers(1, 6), y0 : y0 + rng.integers(1, 5)] = True
+        result = boundary_following(CollisionMap.from_array(occ, tl))
+        exhaustive = schedules.exhaustive_min_delay(CollisionMap.from_array(occ, tl))
+        assert result.delay == exhaustive
+        outcomes["agree" if exhaustive is not None else "none"] += 1
+    assert outcomes["agree"] > 200 and outcomes["none"] > 10
