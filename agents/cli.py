@@ -146,7 +146,8 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
         nargs="*",
         default=[],
         metavar="KEY=VALUE",
-        help="keywords for gym.make, values read as YAML",
+        help="keywords for gym.make (the environment's own, or max_episode_steps); "
+        "values read as YAML",
     )
     parser.add_argument("--out", type=Path, default=Path("results"), help="output folder")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -31,6 +31,15 @@ def make_env(env_id: str, env_kwargs: dict[str, Any] | None = None, **make_kwarg
         raise UsageError(f"bad keyword for {env_id}: {error}") from error
 
 
+def importable_id(env_id: str) -> str:
+    """``motiongym:motiongym/X-v0``: the form that imports motiongym before making.
+
+    A spawned subprocess (SubprocVecEnv) starts without motiongym imported,
+    so the IDs are not registered there; this form registers them first.
+    """
+    return f"motiongym:{env_id}" if env_id in ENV_IDS else env_id
+
+
 def short_name(env_id: str) -> str:
     """``motiongym/Sweeper-v0`` -> ``Sweeper-v0`` (file and folder names)."""
     return env_id.split("/")[-1]

@@ -37,7 +37,7 @@ from stable_baselines3.common.vec_env import (
 )
 
 from motiongym.agents.config import algorithm_kwargs, default_config_path, load_config
-from motiongym.agents.environments import check_env_id, short_name
+from motiongym.agents.environments import check_env_id, importable_id, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.predictors import MODEL_FILE, NORMALIZATION_FILE, algorithm_classes
 from motiongym.agents.vector import VectorEnvAdapter
@@ -74,7 +74,7 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         return VecMonitor(venv, str(monitor_dir / "native") if monitor_dir else None)
     vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
     return make_vec_env(
-        env_id,
+        importable_id(env_id),
         n_envs=n_envs,
         seed=seed,
         env_kwargs=config["env_kwargs"],

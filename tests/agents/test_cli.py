@@ -5,11 +5,14 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from importlib import resources
 from pathlib import Path
 
 import pytest
+import yaml
 
 from motiongym.agents.cli import main
+from motiongym.agents.config import load_config
 from motiongym.baselines import scripted_policies
 from motiongym.envs import ENV_IDS
 
@@ -72,7 +75,7 @@ def test_evaluate_writes_json_and_csv_with_the_env_measures(capsys, tmp_path):
         str(tmp_path),
         "--no-progress",
         "--env-kwargs",
-        "map=room",
+        "map_name=room",
     ]
     assert main(argv) == 0
     data = json.loads(next(tmp_path.glob("*.json")).read_text())
@@ -81,12 +84,38 @@ def test_evaluate_writes_json_and_csv_with_the_env_measures(capsys, tmp_path):
     assert len(next(tmp_path.glob("*.csv")).read_text().splitlines()) == 3
 
 
+def test_every_shipped_config_block_is_valid():
+    files = sorted(Path(str(resources.files("motiongym.configs"))).glob("*.yml"))
+    assert files
+    for path in files:
+        assert f"motiongym/{path.stem}" in ENV_IDS, f"{path.name} names no registered ID"
+        for algo in yaml.safe_load(path.read_text()):
+            config = load_config(path, algo)
+            assert config["n_timesteps"] > 0
+
+
 def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
-    argv = ["train", SWEEPER, "--timesteps", "256", "--out", str(tmp_path), "--no-progress"]
+    config = tmp_path / "tiny.yml"
+    config.write_text(
+        "ppo:\n  n_envs: 2\n  n_timesteps: 128\n  policy: MultiInputPolicy\n  n_steps: 64\n"
+        "  batch_size: 64\n  eval_freq: 64\n  n_eval_episodes: 1\n"
+        "  env_kwargs: {map_name: room, max_episode_steps: 100}\n"
+    )
+    argv = ["train", SWEEPER, "--config", str(config), "--out", str(tmp_path), "--no-progress"]
     assert main(argv) == 0
     (run_dir,) = (tmp_path / "Sweeper-v0").iterdir()
-    for name in ("model.zip", "config.yml", "command.txt", "eval", "tb", "checkpoints"):
+    for name in (
+        "model.zip",
+        "config.yml",
+        "command.txt",
+        "eval/evaluations.npz",
+        "eval/learning_curve.png",
+        "tb",
+        "checkpoints",
+        "monitor",
+    ):
         assert (run_dir / name).exists(), name
+    assert yaml.safe_load((run_dir / "config.yml").read_text())["n_steps"] == 64
     out = tmp_path / "eval"
     argv = [
         "evaluate",
@@ -99,7 +128,8 @@ def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
         str(out),
         "--no-progress",
         "--env-kwargs",
-        "map=room",
+        "map_name=room",
+        "max_episode_steps=100",
     ]
     assert main(argv) == 0
     assert json.loads(next(out.glob("*.json")).read_text())["summary"]["length"]["mean"] > 0

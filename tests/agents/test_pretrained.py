@@ -26,17 +26,41 @@ def test_shipped_model_verifies_loads_and_runs_an_episode(env_id, name):
     assert evaluation.episodes[0]["length"] > 0
 
 
+TINY_CONFIG = """
+ppo:
+  n_envs: 1
+  n_timesteps: 64
+  policy: MlpPolicy
+  n_steps: 64
+  batch_size: 32
+  normalize: true
+"""
+
+
 @pytest.fixture(scope="module")
 def shipped_folder(tmp_path_factory):
     root = tmp_path_factory.mktemp("ship")
+    config = root / "tiny.yml"
+    config.write_text(TINY_CONFIG)
     run_dir = train(
-        "motiongym/Sweeper-v0", "ppo", out_root=root / "runs", n_timesteps=128, progress=False
+        "motiongym/ExcavatorReach-v0",
+        "ppo",
+        config_path=config,
+        out_root=root / "runs",
+        progress=False,
     )
     return ship(run_dir, n_episodes=1, root=root / "pretrained")
 
 
 def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folder, tmp_path):
-    for name in ("model.zip", "config.yml", "command.txt", "metrics.json", "manifest.json"):
+    for name in (
+        "model.zip",
+        "vecnormalize.pkl",
+        "config.yml",
+        "command.txt",
+        "metrics.json",
+        "manifest.json",
+    ):
         assert (shipped_folder / name).is_file(), name
     verify_manifest(shipped_folder)
     tampered = tmp_path / "tampered"

@@ -45,6 +45,10 @@ def _assert_same(a, b):
         assert a.keys() == b.keys()
         for key in a:
             _assert_same(a[key], b[key])
+    elif isinstance(a, tuple | list):
+        assert len(a) == len(b)
+        for x, y in zip(a, b, strict=True):
+            _assert_same(x, y)
     else:
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
 
@@ -118,8 +122,9 @@ def test_pickled_environment_continues_identically(env_id):
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_runs_in_spawned_subprocesses(env_id):
+    # A spawned process has not imported motiongym: the "module:ID" form imports it.
     venv = make_vec_env(
-        env_id,
+        f"motiongym:{env_id}",
         n_envs=2,
         seed=0,
         vec_env_cls=SubprocVecEnv,
