@@ -27,18 +27,41 @@ class DualArmCellEnv(gym.Env):
     is to start robot 2 late by the smallest delay that avoids collision.
 
     ## Action
-    ``control="both"``: Box(0, 1, (2,)) float32: advance of robot 1, robot 2
-    (samples per step). ``control="robot_2"`` (the paper's setting): Box(0, 1,
-    (1,)): robot 2's advance; robot 1 runs on its nominal schedule. Values are
-    clipped into [0, 1] (never faster, never backwards); NaN or a wrong shape
-    raises ``ValueError``.
+    ``control="both"``: Box(0, 1, (2,)) float32; ``control="robot_2"`` (the
+    paper's setting, robot 1 on its nominal schedule): Box(0, 1, (1,)).
+
+    =====  =========================================  ===============
+    index  meaning                                    unit
+    =====  =========================================  ===============
+    0      robot 1 advance ("both" only)              samples / step
+    0 / 1  robot 2 advance                            samples / step
+    =====  =========================================  ===============
+
+    Values are clipped into [0, 1] (never faster, never backwards); NaN or a
+    wrong shape raises ``ValueError``. Between samples the joints are
+    interpolated linearly.
 
     ## Observation
-    Box (94,) float32; see :mod:`motiongym.envs.dual_arm.world` for the table:
-    both arms' joints (rad), progress fractions, elapsed time (s), the 25 link
-    pair distances ``d_ij`` (m), and both tasks in compact form (4 via
-    configurations, 3 segment durations each), from which a planner rebuilds
-    the trajectories (``world.tasks_from_observation``) and the collision map.
+    Box (94,) float32 (slices by name in ``world.OBS``):
+
+    ======  ==========================================  =====  ===============
+    index   meaning                                      unit   frame
+    ======  ==========================================  =====  ===============
+    0-5     robot 1 joint angles q1..q6                  rad    robot 1 joints
+    6-11    robot 2 joint angles q1..q6                  rad    robot 2 joints
+    12-13   progress p_r / N_r of robot 1, robot 2       -      -
+    14      elapsed time (steps x 0.02)                  s      -
+    15-39   d_ij (paper eq. 1), row i = robot-1 body,    m      -
+            col j = robot-2 body; bodies: upper arm,
+            forearm, wrist roll, wrist bend, gripper
+    40-63   robot 1 via configurations (4 x 6)           rad    robot 1 joints
+    64-66   robot 1 segment durations (3)                s      -
+    67-90   robot 2 via configurations (4 x 6)           rad    robot 2 joints
+    91-93   robot 2 segment durations (3)                s      -
+    ======  ==========================================  =====  ===============
+
+    From the tasks (40-93) a planner rebuilds both trajectories
+    (``world.tasks_from_observation``) and the collision map.
 
     ## Reward
     Sum of named terms, each in ``info`` as ``reward_<term>``, weighted by the

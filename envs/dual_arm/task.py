@@ -172,7 +172,7 @@ def _check_pair(seg1: tuple, seg2: tuple, margin: float) -> tuple[bool, bool]:
     n1, n2 = len(a1) - 1, len(a2) - 1
     k = np.arange(max(n1, n2) + 1)
     i1, i2 = np.minimum(k, n1), np.minimum(k, n2)
-    if not model.segments_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin).any():
+    if not model.segments_any_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin):
         return False, True  # sequential clearance not needed: rejected anyway
     return True, _sequential_ok(seg1, seg2, margin)
 
@@ -182,7 +182,7 @@ def _sequential_ok(seg1: tuple, seg2: tuple, margin: float) -> bool:
     n1, n2 = len(a1) - 1, len(a2) - 1
     i1 = np.concatenate([np.arange(n1 + 1), np.full(n2 + 1, n1)])
     i2 = np.concatenate([np.zeros(n1 + 1, int), np.arange(n2 + 1)])
-    return not bool(model.segments_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin).any())
+    return not model.segments_any_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin)
 
 
 def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
