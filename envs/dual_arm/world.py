@@ -135,6 +135,7 @@ class DualArmWorld:
         if self._renderer is None:
             self._renderer = mujoco.Renderer(self.cell.model, height, width)
         self.cell.set_joints(*self.q)
+        mujoco.mj_camlight(self.cell.model, self.cell.data)  # cameras and lights
         self._renderer.update_scene(self.cell.data, camera="overview")
         return self._renderer.render().copy()
 
