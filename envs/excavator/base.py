@@ -245,30 +245,39 @@ class ExcavatorBase(gym.Env):
     def _clearances(self) -> None:
         """Pipe and truck clearance: cheap lower bounds first, exact when under HORIZON.
 
-        Every arm point lies on the vertical half-plane at azimuth ``q1``
-        (lateral offset ``-d2``), between radii ``rmin`` and ``rmax`` and above
-        height ``lowest``. Pipe: horizontal gap from that radial segment to the
-        pipe's (infinite) line in plan, vertical gap to the pipe's top; the
-        distance is at least their Euclidean combination. Truck: lateral gap
-        of the footprint's corners to the boom plane (all on one side), or the
-        radial gap between the arm and the footprint's corners (a projection
-        is 1-Lipschitz and a box's projection spans its corners'), or the
-        height above the rim.
+        Every arm point lies on the vertical plane at azimuth ``q1`` (lateral
+        offset ``-d2``); link ``k`` spans radii ``[ra, rb]`` and heights
+        ``[za, zb]`` in it. Lower bounds per link (a projection is
+        1-Lipschitz, and a box's projection spans its corners'):
+
+        * pipe: plan gap from the link's radial segment to the pipe's
+          (infinite) line, vertical gap from the link's lowest point to the
+          pipe's axis; the distance is at least their Euclidean combination;
+        * truck: the largest of the lateral gap of the footprint's corners to
+          the plane (all on one side), the radial gap between the link and the
+          corners, and the link's height above the rim.
+
+        The exact distance (:mod:`.obstacles`) is computed when a link's bound
+        is under ``HORIZON``; else the smallest bound is reported.
         """
         pts = self.points
+        r_link = self.m.link_radius
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
         ox, oy = -self.m.L0 + s1 * self.m.d2, -c1 * self.m.d2  # the plane's origin in plan
         radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
-        rmin, rmax = min(radial), max(radial)
-        lowest = min(pts[0][2], pts[1][2], pts[2][2], pts[3][2])
-        # Pipe.
-        (px, py), (ux, uy), plen = self._pipe_line
-        gaps = []
-        for r in (rmin, rmax):
-            gaps.append((ox + c1 * r - px) * -uy + (oy + s1 * r - py) * ux)
-        horizontal = 0.0 if gaps[0] * gaps[1] <= 0.0 else min(abs(gaps[0]), abs(gaps[1]))
-        vertical = max(lowest - self._pipe_zmax, 0.0)
-        bound = math.hypot(horizontal, vertical) - self._max_r - self.pipe.radius
+        heights = [p[2] for p in pts]
+        # Pipe: the plan gap is linear in the radius, g(r) = a + b r.
+        (px, py), (ux, uy), _ = self._pipe_line
+        a = (ox - px) * -uy + (oy - py) * ux
+        b = c1 * -uy + s1 * ux
+        g = [a + b * r for r in radial]
+        zmax, rp = self._pipe_zmax, self.pipe.radius
+        bound = math.inf
+        for k in range(3):
+            g0, g1 = g[k], g[k + 1]
+            plan = 0.0 if g0 * g1 <= 0.0 else min(abs(g0), abs(g1))
+            vertical = max(min(heights[k], heights[k + 1]) - zmax, 0.0)
+            bound = min(bound, math.hypot(plan, vertical) - r_link[k] - rp)
         if bound < HORIZON:
             starts, ends = np.array(pts[:3]), np.array(pts[1:])
             self.pipe_clear = pipe_clearance(starts, ends, self._radii, self.pipe)
@@ -278,11 +287,18 @@ class ExcavatorBase(gym.Env):
         lateral = [-s1 * (x - ox) + c1 * (y - oy) for x, y in self._truck_corners]
         lo, hi = min(lateral), max(lateral)
         side = 0.0 if lo * hi <= 0.0 else min(abs(lo), abs(hi))
-        bound = max(side, lowest - self.truck.height) - self._max_r
-        if bound < HORIZON:
+        rim = self.truck.height
+        if side - self._max_r >= HORIZON:
+            bound = side - self._max_r
+        else:
             along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
-            ahead = max(min(along) - rmax, rmin - max(along), 0.0)
-            bound = max(bound, ahead - self._max_r)
+            amin, amax = min(along), max(along)
+            bound = math.inf
+            for k in range(3):
+                ra, rb = radial[k], radial[k + 1]
+                ahead = max(amin - max(ra, rb), min(ra, rb) - amax, 0.0)
+                above = min(heights[k], heights[k + 1]) - rim
+                bound = min(bound, max(side, ahead, above) - r_link[k])
         if bound < HORIZON:
             starts, ends = np.array(pts[:3]), np.array(pts[1:])
             self.truck_clear = truck_clearance(

@@ -36,6 +36,7 @@ Resistance (simplified fundamental earthmoving equation)
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -57,6 +58,22 @@ def speed_fraction(depth: float, width: float, m: Machine) -> float:
     if depth <= 0.0:
         return 1.0
     return min(1.0, max(m.min_speed_fraction, 1.0 - cutting_force(depth, width, m) / m.dig_force))
+
+
+@functools.lru_cache(maxsize=256)
+def _sweep_weights(n_s: int, n_u: int) -> tuple[np.ndarray, np.ndarray]:
+    """Bilinear weights of the sub-cell centres of the swept quad.
+
+    Sample ``(s, u)`` at ``((k + 0.5) / n_s, (l + 0.5) / n_u)`` weighs the
+    corners ``(a0, b0, a1, b1)`` by ``((1-s)(1-u), (1-s)u, s(1-u), su)``;
+    also returns ``s`` per sample (for the edge height).
+    """
+    s = np.repeat((np.arange(n_s) + 0.5) / n_s, n_u)  # (n_s * n_u,)
+    u = np.tile((np.arange(n_u) + 0.5) / n_u, n_s)
+    weights = np.column_stack([(1 - s) * (1 - u), (1 - s) * u, s * (1 - u), s * u])
+    weights.setflags(write=False)
+    s.setflags(write=False)
+    return weights, s
 
 
 class Terrain:
@@ -126,15 +143,9 @@ class Terrain:
         ys = (edge0[0][1], edge0[1][1], edge1[0][1], edge1[1][1])
         i0, i1 = int((min(xs) - self.x0) * inv), int((max(xs) - self.x0) * inv) + 1
         j0, j1 = int((min(ys) - self.y0) * inv), int((max(ys) - self.y0) * inv) + 1
-        a0, b0 = np.asarray(edge0[0], float), np.asarray(edge0[1], float)
-        a1, b1 = np.asarray(edge1[0], float), np.asarray(edge1[1], float)
-        # Samples at the centres of n_u x n_s sub-cells of the swept quad (half a
-        # cell apart): a cell is cut where the quad covers its middle part.
-        u = ((np.arange(n_u) + 0.5) / n_u)[None, :, None]  # (1, n_u, 1)
-        s = ((np.arange(n_s) + 0.5) / n_s)[:, None, None]  # (n_s, 1, 1)
-        start = a0 + u * (b0 - a0)
-        pts = (start + s * ((a1 + u * (b1 - a1)) - start)).reshape(-1, 2)  # (n_s * n_u, 2)
-        zs = np.repeat(z0 + s[:, 0, 0] * (z1 - z0), n_u)
+        weights, along = _sweep_weights(n_s, n_u)  # (n_s * n_u, 4), (n_s * n_u,)
+        pts = weights @ np.array((edge0[0], edge0[1], edge1[0], edge1[1]))  # (n_s * n_u, 2)
+        zs = z0 + along * (z1 - z0)
         ij = ((pts - (self.x0, self.y0)) * inv).astype(np.intp)
         i, j = ij[:, 0], ij[:, 1]
         if min(xs) < self.x0 or min(ys) < self.y0 or i1 > self.nx or j1 > self.ny:

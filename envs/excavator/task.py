@@ -65,21 +65,28 @@ class Scene:
     target: np.ndarray | None = None  # (4,) tip x, y, z (m) and bucket angle (rad)
 
 
+_XS = GRID_ORIGIN[0] + (np.arange(GRID_SHAPE[0]) + 0.5) * GRID_CELL  # (nx,) cell centres
+_YS = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL  # (ny,)
+# Undulations fade in from the pad's edge over 1 m.
+_FADE = np.clip((np.hypot(_XS[:, None], _YS[None, :]) - PAD_RADIUS) / 1.0, 0.0, 1.0)
+
+
 def sample_heights(rng: np.random.Generator) -> np.ndarray:
-    """Initial ground heights, shape ``GRID_SHAPE``."""
-    xs = GRID_ORIGIN[0] + (np.arange(GRID_SHAPE[0]) + 0.5) * GRID_CELL
-    ys = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL
-    x, y = np.meshgrid(xs, ys, indexing="ij")
+    """Initial ground heights, shape ``GRID_SHAPE``.
+
+    Two plane waves ``amp sin(k (cos d x + sin d y) + phase)``, each computed
+    as ``sin A cos B + cos A sin B`` from outer products (separable in x, y).
+    """
     h = np.zeros(GRID_SHAPE)
     for _ in range(2):
         k = rng.uniform(0.3, 0.8)
         direction = rng.uniform(0.0, 2 * math.pi)
         phase = rng.uniform(0.0, 2 * math.pi)
         amp = rng.uniform(0.0, 0.075)
-        h += amp * np.sin(k * (math.cos(direction) * x + math.sin(direction) * y) + phase)
-    r = np.hypot(x, y)
-    fade = np.clip((r - PAD_RADIUS) / 1.0, 0.0, 1.0)
-    return h * fade
+        a = k * math.cos(direction) * _XS + phase  # (nx,)
+        b = k * math.sin(direction) * _YS  # (ny,)
+        h += amp * (np.outer(np.sin(a), np.cos(b)) + np.outer(np.cos(a), np.sin(b)))
+    return h * _FADE
 
 
 def sample_truck(rng: np.random.Generator) -> Truck:
