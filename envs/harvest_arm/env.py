@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import gymnasium as gym
@@ -138,10 +139,13 @@ class HarvestArmEnv(gym.Env):
         self.layout = ObservationLayout(n, self.dim, len(self.index["point_sites"]), n_obstacles)
         self._slices = self.layout.slices
         self._limits = self.spec_arm.limits
+        self._low = -self._limits
         self._speeds = self.spec_arm.speeds
+        self._step_size = self._speeds * self.dt  # rad per unit action
         low, high = self.layout.bounds(self._speeds)
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
+        self._action_shape = (n,)
         # contact (geom1, geom2) -> flat index into the (L, K) clearance matrix
         links, obstacles = self.index["link_geoms"], self.index["obstacle_geoms"]
         self._pair_slot = np.zeros((self.model.ngeom, self.model.ngeom), dtype=np.int64)
@@ -230,6 +234,8 @@ class HarvestArmEnv(gym.Env):
         m.geom_pos[self.index["fruit_geom"][0]] = fruit3
         m.geom_size[self.index["fruit_geom"][0]] = (FRUIT_RADIUS, 0.0, 0.0)
         self.scene = scene
+        self._n_pairs = len(self.index["link_geoms"]) * len(scene)
+        self._slots: np.ndarray | None = None  # contact order -> clearance slot, set once
         s = self._slices
         self._obs[s["fruit"]] = scene.fruit
         self._obs[s["obstacles"]] = obstacles.ravel()
@@ -239,20 +245,18 @@ class HarvestArmEnv(gym.Env):
     # ------------------------------------------------------------------- step
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         a = np.asarray(action, dtype=np.float64)
-        if a.shape != self.action_space.shape:
+        if a.shape != self._action_shape:
             raise ValueError(
-                f"action must have shape {self.action_space.shape} (one rate per joint), "
-                f"got {a.shape}"
+                f"action must have shape {self._action_shape} (one rate per joint), got {a.shape}"
             )
-        if not np.isfinite(a).all():
+        if not math.isfinite(a.sum()):
             raise ValueError(f"action must be finite (no NaN or inf), got {a}")
         if self.scene is None:
             raise RuntimeError("call reset() before step()")
         a = np.minimum(np.maximum(a, -1.0), 1.0)
         q_old = self._q
-        self._q = np.minimum(
-            np.maximum(q_old + a * self._speeds * self.dt, -self._limits), self._limits
-        )
+        q = q_old + a * self._step_size  # rad
+        self._q = np.minimum(np.maximum(q, self._low), self._limits)
         self._update((self._q - q_old) / self.dt)
         d_fruit = self._distance_to_fruit()
         min_d = self._min_d
@@ -282,9 +286,18 @@ class HarvestArmEnv(gym.Env):
         mujoco.mj_collision(self.model, d)
         clear = self._clear
         clear.fill(DISTANCE_CLIP)
-        if d.ncon:
-            geom = d.contact.geom  # (ncon, 2)
-            np.minimum.at(clear, self._pair_slot[geom[:, 0], geom[:, 1]], d.contact.dist)
+        if d.ncon == self._n_pairs and self._slots is not None:
+            # one contact per pair, in the model's pair order (the explicit pairs are
+            # the only collision source and every present pair is within the margin)
+            clear[self._slots] = np.minimum(d.contact.dist, DISTANCE_CLIP)
+        elif d.ncon:
+            geom, dist = d.contact.geom, d.contact.dist  # (ncon, 2), (ncon,)
+            slots = self._pair_slot[geom[:, 0], geom[:, 1]]
+            if d.ncon == self._n_pairs:
+                self._slots = slots
+                clear[slots] = np.minimum(dist, DISTANCE_CLIP)
+            else:  # a pair with two contacts (parallel capsules): keep the smaller
+                np.minimum.at(clear, slots, dist)
         self._min_d = float(clear.min())
         obs[self._s_sin] = np.sin(q)
         obs[self._s_cos] = np.cos(q)

@@ -115,7 +115,7 @@ def solve_ik(
         points, jac = kin.jacobians(q)
         e = target - points[-1]
         err = float(np.linalg.norm(e))
-        if err < 1e-4:
+        if err < 5e-4:
             break
         stalled = stalled + 1 if err > 0.98 * best else 0
         best = min(best, err)
@@ -130,7 +130,10 @@ def solve_ik(
 def clearance_to_arm(points: np.ndarray, link_radius: float, scene: Scene) -> np.ndarray:
     """Surface clearance of each obstacle to the arm given by its points: (K,)."""
     p0, p1 = points[:-1, None, :], points[1:, None, :]  # (L, 1, dim)
-    dist, _, _ = closest_points_between_segments(p0, p1, scene.a[None], scene.b[None])  # (L, K)
+    if scene.is_bar.any():
+        dist = closest_points_between_segments(p0, p1, scene.a[None], scene.b[None])[0]  # (L, K)
+    else:  # spheres only: the cheaper point-segment distance
+        dist = closest_point_on_segment(scene.a[None], p0, p1)[0]  # (L, K)
     return dist.min(axis=0) - link_radius - scene.radius
 
 

@@ -86,6 +86,21 @@ def test_clearances_match_numpy_geometry_and_mj_geom_distance():
                 assert min(d, 1.0) == pytest.approx(expected[li, k], abs=1e-6)
 
 
+@pytest.mark.parametrize(("planar", "dof"), [(False, 7), (True, 4)])
+def test_clearances_stay_exact_along_a_rollout(planar, dof):
+    env = _make(planar, dof, terminate_on_collision=False).unwrapped
+    env.reset(seed=5)
+    rng = np.random.default_rng(5)
+    for _ in range(40):
+        observation, *_ = env.step(rng.uniform(-1, 1, dof).astype(np.float32))
+        o = env.layout.parse(observation)
+        dist, _, _ = closest_points_between_segments(
+            o["points"][:-1, None], o["points"][1:, None], o["a"][None], o["b"][None]
+        )
+        expected = np.minimum(dist - env.link_radius - o["radius"][None], 1.0)
+        np.testing.assert_allclose(o["distances"], expected, atol=1e-5)
+
+
 def test_planar_clearance_of_a_known_case():
     env = _make(True, 3).unwrapped
     length = 0.861 / 3
