@@ -279,3 +279,15 @@ def solve(
     else:
         reason, converged = _diagnose(tip, beta, m, base, singular), False
     return IKResult(q, converged, reason, k, np.array(errors), pos, ang)
+
+
+def solve_paper_case() -> IKResult:
+    """The paper's case on the default machine, from the rest pose (a benchmark hook).
+
+    20 Newton-Raphson iterations of eq. 13 would be the paper's protocol; this
+    stops at the tolerances (6 iterations) as a solver in use does.
+    """
+    from motiongym.envs.excavator.config import DEFAULT_MACHINE
+
+    tip, beta = paper_target(DEFAULT_MACHINE)
+    return solve(tip, beta, DEFAULT_MACHINE)

@@ -102,3 +102,24 @@ def test_solve_pose_handles_large_bucket_turns_near_90_degrees_of_swing():
     h = forward(q, M)
     result = solve_pose(h[:3, 3], bucket_angle(q), M, q_start=np.array([1.8, 0.9, -1.5, -2.0]))
     assert result.converged
+
+
+def test_policies_rebuild_a_different_machine_from_env_kwargs():
+    kwargs = {"machine": {"L2": 6.2, "L3": 3.1, "d1": 2.2}}
+    env = gym.make("motiongym/ExcavatorReach-v0", **kwargs)
+    policy = make_policy(
+        "motiongym/ExcavatorReach-v0",
+        "newton-raphson-reach",
+        env.observation_space,
+        env.action_space,
+        kwargs,
+    )
+    for seed in range(4):
+        obs, _ = env.reset(seed=seed)
+        start, done = True, False
+        while not done:
+            action, _ = policy.predict(obs, episode_start=start)
+            start = False
+            obs, _, terminated, truncated, info = env.step(action)
+            done = terminated or truncated
+        assert info["is_success"]
