@@ -2,8 +2,11 @@
 
 The sweeper knows nothing of the area in advance. Each observation's
 ``sensed`` window (obstacles around the footprint) and ``swept`` window are
-written into full-resolution maps at the believed pose; the footprint is
-marked swept. Planning works on the bounding box of what has been sensed,
+written into full-resolution maps at the believed pose (the latest window
+wins, so a drifted map heals where it is seen again); the footprint is
+marked swept. Cells felt by a bump stay obstacles while the robot stands
+there: under odometry error the window may show them free, and trusting it
+would bump on the same spot for ever. Planning works on the bounding box of what has been sensed,
 padded by the robot width, so its cost follows the explored area, not the
 largest allowed map.
 """
@@ -33,6 +36,7 @@ class RobotMap:
         side = MAX_SIDE + 2 * self.off
         self.occ = np.full((side, side), UNKNOWN, np.int8)  # (side, side)
         self.swept = np.zeros((side, side), bool)  # (side, side)
+        self.felt = np.zeros((side, side), bool)  # (side, side) obstacles felt by bumping
         self.lo = np.array([10**9, 10**9])  # bounding box of sensed cells (array index)
         self.hi = np.array([-1, -1])
 
@@ -43,7 +47,9 @@ class RobotMap:
         bump = bool(pose[3] > 0.5)
         o, R, S, w = self.off, self.R, self.S, self.w
         r0, c0 = r - R + o, c - R + o
-        self.occ[r0 : r0 + S, c0 : c0 + S] = np.asarray(obs["sensed"]).reshape(S, S) > 0.5
+        window = np.asarray(obs["sensed"]).reshape(S, S) > 0.5
+        window |= self.felt[r0 : r0 + S, c0 : c0 + S]  # a bump outweighs the range sensor
+        self.occ[r0 : r0 + S, c0 : c0 + S] = window
         self.swept[r0 : r0 + S, c0 : c0 + S] |= np.asarray(obs["swept"]).reshape(S, S) > 0.5
         self.swept[r + o : r + o + w, c + o : c + o + w] = True
         self.lo = np.minimum(self.lo, (r0, c0))
@@ -51,8 +57,13 @@ class RobotMap:
         return r, c, h, bump
 
     def mark_obstacle(self, cells_r: np.ndarray, cells_c: np.ndarray) -> None:
-        """Record obstacle cells (map frame), e.g. felt by a bump."""
+        """Record obstacle cells (map frame) felt by a bump; windows keep them until forgotten."""
         self.occ[cells_r + self.off, cells_c + self.off] = OBSTACLE
+        self.felt[cells_r + self.off, cells_c + self.off] = True
+
+    def forget_felt(self) -> None:
+        """Drop the bump marks (they become plain map cells, rewritten when seen again)."""
+        self.felt[:] = False
 
     def window(self) -> tuple[int, int, np.ndarray, np.ndarray]:
         """``(r0, c0, occ, swept)``: the explored box padded by ``w``; ``r0, c0`` its map origin.

@@ -7,7 +7,8 @@ empty; then sweep the leftovers along walls and obstacles with CWA
 ``sensed``/``swept`` window into its own maps (:mod:`.belief`) at the
 believed ``pose`` and plans on those maps, treating unknown cells as free
 until sensed. Under odometry noise a bump marks the cells ahead as obstacle
-and the current plan is dropped.
+and the current plan is dropped; the felt cells stay obstacles (whatever the
+drifted window says) until the robot has moved on.
 """
 
 from __future__ import annotations
@@ -56,6 +57,7 @@ class Memory:
     cwa_cells: np.ndarray | None = None
     cwa_last: tuple[int, int] | None = None  # (swept cells, leftovers) at the last scan
     started: bool = False
+    last_pose: tuple[int, int] | None = None
     log: list = field(default_factory=list)  # (mode, pose) at each decision, for figures
 
 
@@ -84,6 +86,9 @@ class PsaCwaPolicy(ScriptedPolicy):
         if bump:  # the cells ahead are blocked, whatever the map said
             self._mark_ahead(m, r, c, h)
             m.path.clear()
+        elif (r, c) != m.last_pose and m.map.felt.any():
+            m.map.forget_felt()  # moved on: bump marks were for where it stood
+        m.last_pose = (r, c)
         for _ in range(200):
             a = self._follow(m, r, c, h)
             if a is not None:
