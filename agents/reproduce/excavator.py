@@ -14,8 +14,9 @@ final poses (Fig. 5). It gives no other numbers. We run:
    paper's literal start; with the swing pointed at the target; with swing
    and bucket angle aligned), of the projected variant and of
    Levenberg-Marquardt;
-3. IK on unreachable targets: the reasons given, and that none is reported
-   as converged;
+3. Newton-Raphson beside Levenberg-Marquardt near the arm's singularity
+   (stick almost in line with the boom); IK on unreachable targets: the
+   reasons given, and that none is reported as converged;
 4. the dig-cycle scripted policy (the paper's announced next step) on seeded
    scenes of ``motiongym/Excavator-v0``: bucket fill at the end of the dig,
    soil delivered, spill, pipe contacts, cycle time;
@@ -110,6 +111,43 @@ def random_poses(n: int, seed: int = 0) -> dict[str, Any]:
             "iterations_max": int(max(iterations)) if iterations else None,
             "wrong_pose_reported_converged": wrong,
             "ms_per_solve": 1e3 * elapsed / n,
+        }
+    return out
+
+
+def near_singular(n: int, seed: int = 2) -> dict[str, Any]:
+    """NR vs LM on poses with the stick within 0.005-0.1 rad of the boom line.
+
+    Boom and stick aligned is the arm's singularity; the real stick range
+    keeps 0.52 rad away from it, so this uses the machine with the stick's
+    upper limit moved to 0 (a geometric study, not a reachable pose).
+    """
+    from motiongym.envs.excavator.config import Machine
+
+    machine = Machine(q_max=(math.pi, M.q_max[1], 0.0, M.q_max[3]))
+    rng = np.random.default_rng(seed)
+    cases = []
+    for _ in range(n):
+        q = rng.uniform(machine.q_min, machine.q_max)
+        q[2] = -rng.uniform(0.005, 0.1)
+        cases.append(q)
+    out = {}
+    for method in ("newton", "lm"):
+        reasons, iterations = collections.Counter(), []
+        for q in cases:
+            h = forward(q, machine)
+            q0 = np.array(machine.q_rest)
+            q0[0] = swing_for_target(h[0, 3], h[1, 3], machine)
+            r = nr.solve(
+                h[:3, 3], bucket_angle(q), machine, q0=q0, method=method, max_iterations=50
+            )
+            reasons[r.reason] += 1
+            iterations += [r.iterations] if r.converged else []
+        out[method] = {
+            "n": n,
+            "converged_rate": reasons["converged"] / n,
+            "reasons": dict(reasons),
+            "iterations_median": float(np.median(iterations)) if iterations else None,
         }
     return out
 
@@ -302,6 +340,12 @@ def _print(results: dict[str, Any]) -> None:
             f"max {r['iterations_max']}; wrong {r['wrong_pose_reported_converged']}",
             "-",
         )
+    for name, r in results["near_singular"].items():
+        table.add_row(
+            f"near-singular poses (stick ~ boom line), {name}",
+            f"{100 * r['converged_rate']:.1f} % conv. {r['reasons']}",
+            "-",
+        )
     u = results["unreachable"]
     table.add_row(
         "unreachable targets reported converged",
@@ -345,6 +389,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
         "machine": M.as_dict(),
         "paper_case": paper_case(),
         "random_poses": random_poses(100 if quick else 1000),
+        "near_singular": near_singular(40 if quick else 200),
         "unreachable": unreachable(40 if quick else 200),
         "dig_cycle": dig_cycles(8 if quick else 100),
         "speed": speed(2000 if quick else 20000),

@@ -49,3 +49,16 @@ def test_files_written(results):
     assert (out / "fig4_convergence.png").stat().st_size > 10_000
     assert (out / "fig5_pose.png").stat().st_size > 10_000
     assert r["speed"]["ik_solves_per_s_paper_case"] > 0
+
+
+@pytest.mark.slow
+def test_full_protocol(tmp_path):
+    r = excavator.run(tmp_path, quick=False)
+    assert r["random_poses"]["newton_rest_aligned"]["n"] == 1000
+    assert r["random_poses"]["newton_rest_aligned"]["converged_rate"] >= 0.95
+    assert all(v["wrong_pose_reported_converged"] == 0 for v in r["random_poses"].values())
+    assert r["unreachable"]["reported_converged"] == 0
+    near = r["near_singular"]
+    assert near["lm"]["converged_rate"] > near["newton"]["converged_rate"]
+    d = r["dig_cycle"]
+    assert d["n"] == 100 and d["success_rate"] >= 0.98 and d["pipe_contacts"] == 0
