@@ -109,6 +109,9 @@ class ExcavatorBase(gym.Env):
         """``(reward terms, success, extra info)`` after the physics of a step."""
         raise NotImplementedError
 
+    def _on_cut(self, volume: float) -> None:
+        """Called after the bucket took ``volume`` m3 (``terrain.last_cut`` says where)."""
+
     def _task_obs(self, buf: np.ndarray) -> None:
         """Write the task's changing slices into ``buf`` (static ones are set at reset)."""
 
@@ -226,7 +229,10 @@ class ExcavatorBase(gym.Env):
         edge = self._edge()
         if z < top or self._prev_tip_z < top:
             free = m.bucket_capacity - self.fill
-            self.fill += self.terrain.carve(self._prev_edge, edge, self._prev_tip_z, z, free)
+            taken = self.terrain.carve(self._prev_edge, edge, self._prev_tip_z, z, free)
+            if taken > 0.0:
+                self.fill += taken
+                self._on_cut(taken)
         else:
             self.terrain.last_cut_depth = 0.0
         self._prev_edge = edge

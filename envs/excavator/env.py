@@ -167,7 +167,8 @@ class ExcavatorEnv(ExcavatorBase):
     Success: at least ``success_volume`` m3 in the truck and the bucket empty
     (below 2 % of its capacity) - the cycle is over. Extra ``info``:
     ``dig_fill`` (m3, the largest bucket fill so far: the fill at the end of
-    the dig).
+    the dig); ``outside_zone`` (m3 dug outside the marked strip, which is the
+    zone widened by 0.15 m on every side; reported, not penalised).
     """
 
     __doc__ += (
@@ -186,6 +187,7 @@ class ExcavatorEnv(ExcavatorBase):
             "is_success": "last",
             "cost": "sum",
             "dig_fill": "max",
+            "outside_zone": "last",
             "truck_soil": "last",
             "spill": "last",
             "pipe_contact": "max",
@@ -229,8 +231,15 @@ class ExcavatorEnv(ExcavatorBase):
     def _task_reset(self) -> None:
         self._obs[self.layout["zone"]] = self.scene.zone.as_array()
         self._soil_index = self.layout["truck_soil"].start
+        self._zone_mask = self.scene.zone.mask(0.5 * self.m.bucket_width)
+        self.outside_zone = 0.0
         self._last = (self.fill, self.truck_soil, self.spill)
         self.dig_fill = 0.0
+
+    def _on_cut(self, volume: float) -> None:
+        i0, j0, cut = self.terrain.last_cut
+        inside = self._zone_mask[i0 : i0 + cut.shape[0], j0 : j0 + cut.shape[1]]
+        self.outside_zone += float(cut[~inside].sum()) * self.terrain.cell**2
 
     def _task_obs(self, buf: np.ndarray) -> None:
         buf[self._soil_index] = self.truck_soil
@@ -258,5 +267,6 @@ class ExcavatorEnv(ExcavatorBase):
 
     def _info(self, terms: dict[str, float], success: bool) -> dict[str, Any]:
         info = super()._info(terms, success)
-        info["dig_fill"] = float(getattr(self, "dig_fill", 0.0))
+        info["dig_fill"] = float(self.dig_fill)
+        info["outside_zone"] = float(self.outside_zone)
         return info

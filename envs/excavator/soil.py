@@ -86,6 +86,7 @@ class Terrain:
         self.nx, self.ny = self.h.shape
         self.version = 0  # bumped on every change (for caches)
         self.last_cut_depth = 0.0  # m: deepest cut of the last carve (the resistance depth)
+        self.last_cut: tuple[int, int, np.ndarray] | None = None
         self.max_height = float(self.h.max())
 
     @property
@@ -131,7 +132,9 @@ class Terrain:
             free_capacity: room left in the bucket (m3); the cut is scaled to it.
 
         Sets :attr:`last_cut_depth`, the thickness of soil the edge went
-        through (the depth of cut of the resistance model).
+        through (the depth of cut of the resistance model), and
+        :attr:`last_cut`, ``(i0, j0, depths)``: the depth taken from each cell
+        of the patch starting at cell ``(i0, j0)``.
         """
         self.last_cut_depth = 0.0
         half = 0.5 * self.cell
@@ -165,8 +168,10 @@ class Terrain:
             return 0.0
         if removed > free_capacity:
             scale = max(free_capacity, 0.0) / removed
-            patch[...] = old - (old - patch) * scale
+            cut *= scale
+            patch[...] = old - cut
             removed = max(free_capacity, 0.0)
+        self.last_cut = (i0, j0, cut)
         self.version += 1
         return removed
 

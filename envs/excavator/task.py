@@ -39,6 +39,9 @@ GRID_CELL = 0.1  # m
 PAD_RADIUS = 5.0  # m
 
 
+ZONE_MARGIN = 0.15  # m: the marked strip is this much wider and longer than the nominal one
+
+
 @dataclass(frozen=True)
 class DigZone:
     """A strip along the ray at ``azimuth`` from ``r_near`` to ``r_far`` (m), dug ``depth`` deep."""
@@ -47,6 +50,21 @@ class DigZone:
     r_near: float
     r_far: float
     depth: float
+
+    def mask(self, half_width: float) -> np.ndarray:
+        """Cells (``GRID_SHAPE``) whose centre lies in the strip, ``ZONE_MARGIN`` around it.
+
+        The strip spans ``[r_near, r_far]`` along the ray and ``half_width``
+        each side of it (the bucket's half width).
+        """
+        c, s = math.cos(self.azimuth), math.sin(self.azimuth)
+        along = c * _XS[:, None] + s * _YS[None, :]
+        across = -s * _XS[:, None] + c * _YS[None, :]
+        return (
+            (along >= self.r_near - ZONE_MARGIN)
+            & (along <= self.r_far + ZONE_MARGIN)
+            & (np.abs(across) <= half_width + ZONE_MARGIN)
+        )
 
     def as_array(self) -> np.ndarray:
         """``[x_near, y_near, x_far, y_far, depth]``, shape (5,)."""

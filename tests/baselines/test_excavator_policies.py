@@ -47,6 +47,7 @@ def test_dig_cycle_policy_delivers_without_touching_the_pipe():
     assert all(r["min_pipe"] >= 0.5 for r in results)
     assert np.mean([r["truck_soil"] for r in results]) >= 0.8 * M.bucket_capacity
     assert all(r["spill"] <= 0.05 for r in results)
+    assert all(r["outside_zone"] <= 0.01 for r in results)
     assert all(r["elapsed"] < 30.0 for r in results)
 
 

@@ -133,6 +133,7 @@ def test_digging_fills_the_bucket_slows_the_arm_and_pouring_spills():
         assert not terminated
     assert info["bucket_fill"] > 0.1
     assert volume0 - env.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
+    assert info["outside_zone"] < 0.05 * info["bucket_fill"]  # dug along the marked strip
     # Lift and open the bucket away from the truck: the soil is spilled on the ground.
     for _ in range(40):
         _, _, _, _, info = env.step(np.array([0.0, 1.0, 0.0, 1.0]))
@@ -192,3 +193,22 @@ def test_observation_slices_match_the_state(env_id, task):
         assert obs[lay["truck_soil"]][0] == pytest.approx(env.truck_soil)
     else:
         np.testing.assert_allclose(obs[lay["target"]], env.scene.target, atol=1e-5)
+
+
+def test_digging_beside_the_zone_is_reported():
+    from motiongym.baselines.excavator.newton_raphson import analytic_solutions, within_limits
+
+    env = gym.make("motiongym/Excavator-v0").unwrapped
+    env.reset(seed=4)
+    zone = env.scene.zone
+    azimuth = zone.azimuth + 0.6  # well beside the strip
+    tip = np.array([np.cos(azimuth), np.sin(azimuth), 0.0]) * zone.r_far
+    tip[2] = env.terrain.height_at(tip[0], tip[1]) + 0.05
+    q0 = next(s for s in analytic_solutions(tip, -1.6, env.m) if within_limits(s, env.m))
+    env.reset(seed=4, options={"q0": q0})
+    for _ in range(8):
+        env.step(np.array([0.0, -0.15, 0.0, 0.0]))
+    for _ in range(10):
+        _, _, _, _, info = env.step(np.array([0.0, 0.0, -0.5, -0.2]))
+    assert info["bucket_fill"] > 0.05
+    assert info["outside_zone"] == pytest.approx(info["bucket_fill"], rel=1e-9)
