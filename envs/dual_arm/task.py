@@ -213,7 +213,10 @@ def sample_pair(
         collides, sequential_ok = _check_pair(s1, s2, margin)
         if collides and sequential_ok:
             return t1, t2
-    raise RuntimeError(f"no colliding pair found in {max_tries} tries")
+    raise RuntimeError(
+        f"no pair that collides started together and clears by {margin} m one after the "
+        f"other in {max_tries} tries; lower safety_margin or use task='any'"
+    )
 
 
 # The paper's Fig. 6 trajectories are not in the text: our own pick-and-place pair
