@@ -150,6 +150,7 @@ class ExcavatorBase(gym.Env):
             self._pipe_line = ((a[0], a[1]), (0.0, 0.0), 0.0)
         self._pipe_zmax = max(a[2], b[2])
         self._truck_edges = self.truck.edges()
+        self._truck_radius = math.hypot(self.truck.half_length, self.truck.half_width)
         self._truck_corners = [tuple(c) for c in self._truck_edges[0][:4, :2].tolist()]
         self._radii = np.array(self.m.link_radius)
         self._max_r = max(self.m.link_radius)
@@ -263,40 +264,51 @@ class ExcavatorBase(gym.Env):
           the plane (all on one side), the radial gap between the link and the
           corners, and the link's height above the rim.
 
-        The exact distance (:mod:`.obstacles`) is computed when a link's bound
-        is under ``HORIZON``; else the smallest bound is reported.
+        Before those, whole-arm bounds (the arm's lowest point above the pipe
+        or the rim; the truck's circumscribed circle against the plane) skip
+        the per-link ones when they already exceed ``HORIZON``. The exact
+        distance (:mod:`.obstacles`) is computed when a bound is under
+        ``HORIZON``; else the bound is reported.
         """
         pts = self.points
         r_link = self.m.link_radius
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
         ox, oy = -self.m.L0 + s1 * self.m.d2, -c1 * self.m.d2  # the plane's origin in plan
-        radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
         heights = [p[2] for p in pts]
-        # Pipe: the plan gap is linear in the radius, g(r) = a + b r.
-        (px, py), (ux, uy), _ = self._pipe_line
-        a = (ox - px) * -uy + (oy - py) * ux
-        b = c1 * -uy + s1 * ux
-        g = [a + b * r for r in radial]
+        lowest = min(heights)
+        radial = None
+        # Pipe: first the whole arm's height above it, then per link.
         zmax, rp = self._pipe_zmax, self.pipe.radius
-        bound = math.inf
-        for k in range(3):
-            g0, g1 = g[k], g[k + 1]
-            plan = 0.0 if g0 * g1 <= 0.0 else min(abs(g0), abs(g1))
-            vertical = max(min(heights[k], heights[k + 1]) - zmax, 0.0)
-            bound = min(bound, math.hypot(plan, vertical) - r_link[k] - rp)
+        bound = lowest - zmax - rp - self._max_r
+        if bound < HORIZON:
+            radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
+            # The plan gap to the pipe's line is linear in the radius: a + b r.
+            (px, py), (ux, uy), _ = self._pipe_line
+            a = (ox - px) * -uy + (oy - py) * ux
+            b = c1 * -uy + s1 * ux
+            g = [a + b * r for r in radial]
+            bound = math.inf
+            for k in range(3):
+                g0, g1 = g[k], g[k + 1]
+                plan = 0.0 if g0 * g1 <= 0.0 else min(abs(g0), abs(g1))
+                vertical = max(min(heights[k], heights[k + 1]) - zmax, 0.0)
+                bound = min(bound, math.hypot(plan, vertical) - r_link[k] - rp)
         if bound < HORIZON:
             starts, ends = np.array(pts[:3]), np.array(pts[1:])
             self.pipe_clear = pipe_clearance(starts, ends, self._radii, self.pipe)
         else:
             self.pipe_clear = bound
-        # Truck.
-        lateral = [-s1 * (x - ox) + c1 * (y - oy) for x, y in self._truck_corners]
-        lo, hi = min(lateral), max(lateral)
-        side = 0.0 if lo * hi <= 0.0 else min(abs(lo), abs(hi))
-        rim = self.truck.height
-        if side - self._max_r >= HORIZON:
-            bound = side - self._max_r
-        else:
+        # Truck: first its circumscribed circle's lateral gap and the rim height.
+        truck = self.truck
+        rim = truck.height
+        centre = -s1 * (truck.cx - ox) + c1 * (truck.cy - oy)
+        bound = max(abs(centre) - self._truck_radius, lowest - rim) - self._max_r
+        if bound < HORIZON:
+            lateral = [-s1 * (x - ox) + c1 * (y - oy) for x, y in self._truck_corners]
+            lo, hi = min(lateral), max(lateral)
+            side = 0.0 if lo * hi <= 0.0 else min(abs(lo), abs(hi))
+            if radial is None:
+                radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
             along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
             amin, amax = min(along), max(along)
             bound = math.inf
@@ -307,9 +319,7 @@ class ExcavatorBase(gym.Env):
                 bound = min(bound, max(side, ahead, above) - r_link[k])
         if bound < HORIZON:
             starts, ends = np.array(pts[:3]), np.array(pts[1:])
-            self.truck_clear = truck_clearance(
-                starts, ends, self._radii, self.truck, self._truck_edges
-            )
+            self.truck_clear = truck_clearance(starts, ends, self._radii, truck, self._truck_edges)
         else:
             self.truck_clear = bound
 
