@@ -93,8 +93,6 @@ class ExcavatorBase(gym.Env):
         low, high = obs_layout.bounds(self.TASK, self.m)
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
-        self._low64 = low.astype(np.float64)
-        self._high64 = high.astype(np.float64)
         self._renderer = None
         self.scene: Scene | None = None
 

@@ -17,6 +17,10 @@ from motiongym.envs.excavator.config import Machine
 from motiongym.envs.excavator.task import Scene, sample_dig_scene, sample_reach_scene
 
 _COMMON_INFO = """
+    Keyword arguments: ``machine`` (dict of :class:`Machine` overrides),
+    ``dt`` (s), ``pipe_safety`` (m), the task's tolerances, the reward
+    weights, ``render_mode`` ("rgb_array"), ``render_size`` (rows, columns).
+
     ``info`` (every step and reset): ``is_success``; ``cost`` (1.0 on a step
     where the pipe clearance is below ``pipe_safety``, 0.5 m by default: the
     hand-dig tolerance zone each side of a located utility, or where the arm
@@ -29,14 +33,15 @@ _COMMON_INFO = """
     Termination: success, or contact with the pipe or the truck (clearance
     <= 0). Truncation: only by ``max_episode_steps`` (TimeLimit).
 
-    Reset options: ``q0`` (4 joint angles, rad) instead of the rest pose.
+    Reset options: ``q0`` (4 joint angles, rad, clipped to the joint ranges)
+    instead of the ready pose ``Machine.q_ready`` (bucket curled, 2 m up).
 """
 
 
 class ExcavatorReachEnv(ExcavatorBase):
     """Bring the bucket tip to a target pose (the paper's problem).
 
-    A 20 t backhoe (boom 5.7 m, stick 2.9 m, bucket 1.5 m) starts in its rest
+    A 20 t backhoe (boom 5.7 m, stick 2.9 m, bucket 1.5 m) starts in its ready
     pose; each episode samples a reachable target (tip position and bucket
     angle ``beta``), the ground, a buried pipe and a truck from the seed.
 
