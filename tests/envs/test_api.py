@@ -6,7 +6,6 @@ registered.
 
 from __future__ import annotations
 
-import os
 import pickle
 import subprocess
 import sys
@@ -21,8 +20,6 @@ from stable_baselines3.common.vec_env import SubprocVecEnv
 
 from motiongym.agents.evaluate import AGGREGATIONS, info_measures
 from motiongym.envs import ENV_IDS
-
-os.environ.setdefault("MUJOCO_GL", "egl")
 
 STEPS = 40
 
