@@ -16,6 +16,11 @@ One step (``dt`` s) of the hydraulic machine:
    into the truck if the bucket is over its body, else spilled on the ground;
 6. clearances to the pipe and the truck (:mod:`.obstacles`).
 
+Only the bucket's cutting edge works the ground; boom and stick do not touch
+it (a machine would not drive them into the soil; nothing stops an agent).
+The base stands level at the origin (``H_M^O`` = identity): frame M is the
+world frame.
+
 Subclasses (the tasks) supply ``TASK``, scene sampling, reward and success.
 The scalar state lives in Python floats: the step makes few NumPy calls
 (an environment step costs tens of microseconds).

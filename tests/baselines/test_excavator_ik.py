@@ -110,3 +110,19 @@ def test_bad_arguments_raise():
         nr.solve([5, 0, 0], 0.0, M, jacobian_mode="forward")
     with pytest.raises(ValueError, match="finite"):
         nr.solve([5, np.nan, 0], 0.0, M)
+
+
+def test_solves_with_a_tilted_moved_base():
+    # H_M^O of eq. 1-2: the machine 100 m away on a slope; beta is in frame M.
+    base = base_pose((100.0, 50.0, 3.0), (0.05, -0.08, 1.2))
+    rng = np.random.default_rng(3)
+    converged = 0
+    for q in rng.uniform(M.q_min, M.q_max, size=(40, 4)):
+        h = forward(q, M, base)
+        q0 = np.array(M.q_rest)
+        q0[0] = q[0]
+        result = nr.solve(h[:3, 3], bucket_angle(q), M, q0=q0, base=base)
+        if result.converged:
+            converged += 1
+            np.testing.assert_allclose(forward(result.q, M, base)[:3, 3], h[:3, 3], atol=1e-3)
+    assert converged >= 30
