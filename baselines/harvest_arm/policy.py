@@ -56,7 +56,7 @@ class _ArmPolicy(ScriptedPolicy):
         super().__init__(observation_space, action_space, env_kwargs)
         kw = self.env_kwargs
         planar = bool(kw.get("planar", False))
-        self.arm = arm_spec(int(kw.get("dof", 5 if planar else 7)), planar)
+        self.arm = arm_spec(int(kw.get("dof") or (5 if planar else 7)), planar)
         self.link_radius = float(kw.get("link_radius", 0.02))
         self.dt = float(kw.get("dt", 0.05))
         self.kin = ArmKinematics(self.arm, self.link_radius, self.dt)

@@ -34,8 +34,10 @@ class HarvestArmEnv(gym.Env):
     :mod:`motiongym.envs.harvest_arm.task`.
 
     Variants: ``planar=False`` with ``dof`` 5 (CRS A465 with the added wrist
-    link), 6, 7 and 10 obstacles of which 3 bars; ``planar=True`` with ``dof``
-    3, 4, 5 and 8 spherical obstacles (coordinates x, y).
+    link), 6, 7 (default) and 10 obstacles of which 3 bars; ``planar=True``
+    with ``dof`` 3, 4, 5 (default) and 8 spherical obstacles (coordinates x,
+    y). Links are capsules of radius ``link_radius``; the control period is
+    ``dt`` (registered IDs: 300 steps, 15 s).
 
     Action (Box(-1, 1, (n,))): joint ``j``'s velocity as a fraction of its
     speed limit (rad/s); the pose is clipped to the joint ranges.
