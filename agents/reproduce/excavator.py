@@ -366,9 +366,9 @@ def _print(results: dict[str, Any]) -> None:
         "(next step announced)",
     )
     table.add_row(
-        "dig fill / delivered / spill (mean m3)",
+        "dig fill / delivered / spill / outside zone (mean m3)",
         f"{d['dig_fill_m3']['mean']:.2f} / {d['truck_soil_m3']['mean']:.2f} / "
-        f"{d['spill_m3']['mean']:.3f}",
+        f"{d['spill_m3']['mean']:.3f} / {d['outside_zone_m3']['mean']:.3f}",
         "-",
     )
     table.add_row(
@@ -383,6 +383,12 @@ def _print(results: dict[str, Any]) -> None:
         "Excavator-v0 steps/s vs Reacher-v5",
         f"{s['excavator_v0_steps_per_s']:.0f} vs {s['reacher_v5_steps_per_s']:.0f} "
         f"({s['excavator_v0_ratio_to_reacher']:.2f}x)",
+        "-",
+    )
+    table.add_row(
+        "ExcavatorReach-v0 steps/s vs Reacher-v5",
+        f"{s['excavator_reach_v0_steps_per_s']:.0f} "
+        f"({s['excavator_reach_v0_ratio_to_reacher']:.2f}x)",
         "-",
     )
     Console().print(table)
