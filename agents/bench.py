@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import minigrid  # noqa: F401  (registers the MiniGrid reference)
 import numpy as np
 from rich.markdown import Markdown
 
@@ -37,13 +38,28 @@ REFERENCES = ("CartPole-v1", "Reacher-v5", "MiniGrid-Empty-16x16-v0")
 # Environment throughput goals: ID -> (reference, least ratio to it).
 GOALS: dict[str, tuple[str, float]] = {
     "motiongym/Sweeper-v0": ("CartPole-v1", 0.3),
+    "motiongym/HarvestArm-v0": ("Reacher-v5", 1.0),
+    "motiongym/HarvestArmPlanar-v0": ("Reacher-v5", 1.0),
+    "motiongym/DualArmCell-v0": ("Reacher-v5", 1.0),
+    "motiongym/ExcavatorReach-v0": ("Reacher-v5", 1.0),
+    "motiongym/Excavator-v0": ("Reacher-v5", 1.0),
 }
 # Vectorised-environment goals: ID -> (least steps/s, least ratio to SyncVectorEnv).
 VECTOR_GOALS: dict[str, tuple[float, float]] = {
     "motiongym/Sweeper-v0": (1_000_000.0, 100.0),
 }
 # Planners: label -> ("module:function" taking no argument and planning once, goal in s).
-PLANNERS: dict[str, tuple[str, float | None]] = {}
+PLANNERS: dict[str, tuple[str, float | None]] = {
+    "PSA + CWA, full run on the maze": ("motiongym.baselines.sweeper.run:sweep", 2.0),
+    "boundary following, dual-arm paper case": (
+        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case",
+        0.1,
+    ),
+    "Newton-Raphson IK, excavator paper case": (
+        "motiongym.baselines.excavator.newton_raphson:solve_paper_case",
+        None,
+    ),
+}
 
 
 def machine() -> str:

@@ -195,3 +195,14 @@ def boundary_following(
         result.reason = f"another region after {max_rounds} rounds"
     result.evaluated = cmap.evaluated - before
     return result
+
+
+def plan_paper_case() -> BoundaryResult:
+    """Boundary following on the paper case, from a fresh map (a benchmark hook).
+
+    Building the lazy map is part of planning: its cells are evaluated on
+    demand by the search itself.
+    """
+    from motiongym.envs.dual_arm.task import paper_case
+
+    return boundary_following(CollisionMap.from_tasks(*paper_case(), n_levels=100))
