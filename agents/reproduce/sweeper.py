@@ -222,7 +222,8 @@ def _figures(out_dir: pathlib.Path, results: dict) -> list[str]:
         env = _env(map_name=name, render_mode="rgb_array", cell_pixels=6)
         _episode(env, "psa-cwa", 0)
         ax.imshow(env.render())
-        ax.set_title(f"{name}: PSA + CWA (paper Fig. {dict(room=10, apartment=13, maze=14)[name]})")
+        fig_no = dict(room=10, apartment=13, maze=14)[name]
+        ax.set_title(f"{name}: PSA + CWA (paper Fig. {fig_no})", fontsize=10)
         ax.axis("off")
     fig.tight_layout()
     files.append("sweeper_maps.png")

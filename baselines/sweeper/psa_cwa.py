@@ -65,6 +65,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
     pop_order = "lifo"
+    restart_wide = True  # a wide leftover restarts PSA instead of corner work
     slide_back = False  # shift further back along the lane when blocked at its end
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
 
@@ -255,7 +256,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return None
         m.cwa_last = state
         wide = (world.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
-        if wide.any():  # a region PSA missed, not a corner: restart PSA there
+        if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
             return self._restart_psa(m, r, c, origin, cfree, cur, wide, targets)
         m.cwa_stack = [
             ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
