@@ -5,6 +5,7 @@ from __future__ import annotations
 POLICIES: dict[str, dict[str, str]] = {
     "motiongym/Sweeper-v0": {
         "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
+        "psa-cwa-nearest": "motiongym.baselines.sweeper.psa_cwa:PsaCwaNearestPolicy",
         "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
     },
 }

@@ -358,3 +358,14 @@ class PsaCwaPolicy(ScriptedPolicy):
 
     def _done(self, m: Memory, r: int, c: int, h: int) -> int:
         return LEFT  # nothing left that the robot knows of: turn in place
+
+
+class PsaCwaNearestPolicy(PsaCwaPolicy):
+    """PSA + CWA taking the nearest pending point first instead of the stacks' order.
+
+    Not the paper's algorithm (it pops a LIFO stack and scans CWA top-right to
+    bottom-left): an ablation that shows what the order costs in travel.
+    """
+
+    pop_order = "nearest"
+    cwa_order = "nearest"

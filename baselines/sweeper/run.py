@@ -17,12 +17,13 @@ from motiongym.baselines.policy import ScriptedPolicy
 
 POLICY_CLASSES = {
     "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
+    "psa-cwa-nearest": "motiongym.baselines.sweeper.psa_cwa:PsaCwaNearestPolicy",
     "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
 }
 
 
 def make_policy(name: str, env: gym.Env, env_kwargs: dict[str, Any]) -> ScriptedPolicy:
-    """A sweeper policy by name (``psa-cwa`` or ``wall-follow``)."""
+    """A sweeper policy by name (see :data:`POLICY_CLASSES`)."""
     import importlib
 
     if name not in POLICY_CLASSES:

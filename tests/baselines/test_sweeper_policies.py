@@ -15,7 +15,7 @@ ENV_ID = "motiongym/Sweeper-v0"
 
 
 def test_policies_declared() -> None:
-    assert set(scripted_policies(ENV_ID)) == {"psa-cwa", "wall-follow"}
+    assert set(scripted_policies(ENV_ID)) == {"psa-cwa", "psa-cwa-nearest", "wall-follow"}
 
 
 @pytest.mark.parametrize("map_name", ["room", "apartment", "maze"])
@@ -92,3 +92,9 @@ def test_psa_cwa_under_odometry_noise_keeps_sweeping() -> None:
     info = sweep("room", seed=0, slip_noise=0.05, max_steps=3000)
     assert info["coverage"] > 0.8
     assert np.isfinite(info["travel"])
+
+
+def test_nearest_first_ablation_also_sweeps_everything() -> None:
+    for map_name in ("apartment", "maze"):
+        info = sweep(map_name, seed=0, policy="psa-cwa-nearest")
+        assert info["is_success"]
