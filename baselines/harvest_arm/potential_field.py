@@ -25,8 +25,8 @@ Choices where the paper is silent: ``rho`` is the *surface clearance*
 (centre distance minus the obstacle's radius and the gripper link's radius;
 the paper's obstacles are points and lines, for which the two agree), floored
 at 1 mm; a bar's shortest distance is to the closest point of its segment.
-The integration stops early when the path stalls in a local minimum (progress
-below 1 mm over 50 steps); the policy then drives the rest of the way
+Local minima: see :func:`plan_path` (our stand-in for the paper's
+undescribed "virtual plane concept"); past the path's end the policy drives
 straight to the fruit, as the paper's program always did.
 """
 
@@ -90,11 +90,14 @@ def field_direction(
     gripper_radius: float = 0.0,
     trajectory: FieldParameters = TRAJECTORY,
     target: FieldParameters = TARGET,
+    vortex: bool = False,
 ) -> np.ndarray:
     """Eq. 7's unit direction ``v`` at gripper position ``x`` (dim,).
 
     Obstacles are segments ``a``-``b`` (K, dim) of ``radius`` (K,); a sphere
-    has ``a == b``.
+    has ``a == b``. ``vortex`` turns each obstacle term 45 degrees from
+    "away" towards the way around the obstacle to the fruit (our escape from
+    local minima, see :func:`plan_path`).
     """
     to_fruit = fruit - x
     d = float(np.linalg.norm(to_fruit))
@@ -106,9 +109,26 @@ def field_direction(
         rho = dist - radius - gripper_radius
         mag = obstacle_magnitude(rho, trajectory)  # (K,)
         away = (x - closest) / np.maximum(dist, 1e-12)[:, None]  # (K, dim)
+        if vortex:
+            away = _around(away, to_fruit / d)
         v = v + (mag[:, None] * away).sum(axis=0)
     n = float(np.linalg.norm(v))
     return v / n if n > 1e-12 else np.zeros_like(x)
+
+
+def _around(away: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """``(away + t) / |away + t|``, ``t`` the unit part of ``u`` across ``away`` (K, dim)."""
+    t = u[None, :] - (away @ u)[:, None] * away  # (K, dim)
+    norm = np.linalg.norm(t, axis=1)
+    if away.shape[1] == 2:
+        fixed = np.stack([-away[:, 1], away[:, 0]], axis=1)  # +90 degrees
+    else:
+        axis = np.where(np.abs(away[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+        fixed = np.cross(away, axis)
+        fixed /= np.linalg.norm(fixed, axis=1, keepdims=True)
+    t = np.where(norm[:, None] > 1e-6, t / np.maximum(norm, 1e-12)[:, None], fixed)
+    out = away + t
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
 
 
 def plan_path(
@@ -122,32 +142,60 @@ def plan_path(
     gripper_radius: float = 0.0,
     tolerance: float = 0.005,
     max_steps: int = 1000,
+    escape: bool = True,
 ) -> np.ndarray:
     """RK4 integral of eq. 7 from ``start`` to ``fruit``: path points (N, dim).
 
     ``speed`` is ``|V_end_ref|`` (m/s) and ``step`` the time step (s), so
     consecutive points are about ``speed * step`` apart. The last point is
     the fruit when the path arrives within ``tolerance``.
+
+    A potential field has local minima (an obstacle straight between the
+    gripper and the fruit, common in the plane). The paper pairs the field
+    with a "virtual plane concept" that its text does not describe; our
+    stand-in: when the path stalls (less than 1 mm closer to the fruit over
+    50 steps), the stalled steps are dropped and the obstacle terms turn 45
+    degrees towards the way around each obstacle (``vortex``) until the path
+    is 0.1 m closer to the fruit than where it stalled (at most 150 steps, 5
+    times); then eq. 7 resumes. ``escape=False`` stops at the first stall
+    (the policy then drives straight at the fruit, as the paper's program
+    always did).
     """
     x = np.asarray(start, float).copy()
     fruit = np.asarray(fruit, float)
 
-    def f(p: np.ndarray) -> np.ndarray:
-        return speed * field_direction(p, fruit, a, b, radius, gripper_radius)
+    def f(p: np.ndarray, vortex: bool) -> np.ndarray:
+        return speed * field_direction(p, fruit, a, b, radius, gripper_radius, vortex=vortex)
 
     path = [x.copy()]
     h = step
-    for i in range(max_steps):
-        if np.linalg.norm(fruit - x) <= max(tolerance, speed * h):
+    vortex, since, escapes, d_stall, vortex_steps = False, 0, 5 if escape else 0, 0.0, 0
+    for _ in range(max_steps):
+        d = float(np.linalg.norm(fruit - x))
+        if d <= max(tolerance, speed * h):
             break
-        k1 = f(x)
-        k2 = f(x + 0.5 * h * k1)
-        k3 = f(x + 0.5 * h * k2)
-        k4 = f(x + h * k3)
+        if vortex:
+            vortex_steps += 1
+            if d < d_stall - 0.1 or vortex_steps > 150:
+                vortex, since = False, 0
+        k1 = f(x, vortex)
+        k2 = f(x + 0.5 * h * k1, vortex)
+        k3 = f(x + 0.5 * h * k2, vortex)
+        k4 = f(x + h * k3, vortex)
         x = x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
         path.append(x.copy())
-        if i >= 50 and np.linalg.norm(fruit - path[-51]) - np.linalg.norm(fruit - x) < 1e-3:
-            break  # stalled in a local minimum
+        since += 1
+        if (
+            not vortex
+            and since > 50
+            and np.linalg.norm(fruit - path[-51]) - np.linalg.norm(fruit - x) < 1e-3
+        ):  # stalled in a local minimum
+            if escapes == 0:
+                break
+            del path[-50:]
+            x = path[-1].copy()
+            vortex, escapes, vortex_steps = True, escapes - 1, 0
+            d_stall = float(np.linalg.norm(fruit - x))
     if np.linalg.norm(fruit - x) <= max(tolerance, speed * h):
         path.append(fruit.copy())
     return np.array(path)

@@ -71,6 +71,20 @@ def test_path_goes_around_a_sphere_on_the_straight_line():
     assert np.linalg.norm(v) == pytest.approx(1.0) and v[1] < 0
 
 
+def test_a_local_minimum_is_escaped_or_reported():
+    """An obstacle exactly between gripper and fruit: eq. 7 alone stalls before it."""
+    start, fruit = np.array([0.0, 0.0]), np.array([0.6, 0.0])
+    centre, r = np.array([[0.4, 0.0]]), np.array([0.03])
+    stuck = plan_path(start, fruit, centre, centre, r, gripper_radius=LINK_R, escape=False)
+    assert np.linalg.norm(stuck[-1] - fruit) > 0.1  # stopped in front of the obstacle
+    assert stuck[-1][0] < 0.4
+    path = plan_path(start, fruit, centre, centre, r, gripper_radius=LINK_R)
+    np.testing.assert_allclose(path[-1], fruit)
+    clearance = np.linalg.norm(path - centre, axis=1) - r - LINK_R
+    assert clearance.min() > 0.03
+    assert np.linalg.norm(np.diff(path, axis=0), axis=1).max() < 2 * SPEED * DT
+
+
 def test_path_keeps_clear_of_a_bar_across_the_way():
     a, b = np.array([[0.3, -0.1, 0.05]]), np.array([[0.3, 0.2, 0.05]])
     path = plan_path(np.zeros(3), np.array([0.6, 0.0, 0.0]), a, b, np.array([0.008]))
