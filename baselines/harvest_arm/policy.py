@@ -4,7 +4,8 @@
 
 1. at the episode's first step, plan the gripper's safe path from its start
    to the fruit with the potential field (eq. 2-7, RK4,
-   :mod:`.potential_field`);
+   :mod:`.potential_field`; after a stall in a local minimum, our escape
+   stands in for the paper's undescribed "virtual plane");
 2. every step, the gripper's velocity ``X_dot`` follows that path (aim at the
    path point one control period ahead of the nearest one, at most
    ``|V_end_ref|``; past the path's end, straight at the fruit); the joint
