@@ -237,10 +237,11 @@ def _figures(out_dir: pathlib.Path, results: dict) -> list[str]:
     sp = results["start_position"]
     fig, ax = plt.subplots(figsize=(6, 6))
     grid = maps.shipped_map("maze")
-    ax.imshow(np.where(grid, 0.0, 1.0), cmap="gray", vmin=0, vmax=1)
+    background = np.where(grid[..., None], [0.0, 0.0, 0.0], [0.75, 0.85, 1.0])  # walls, no start
+    ax.imshow(background)
     img = np.ma.masked_invalid(sp["image"])
     im = ax.imshow(img, cmap="gray_r", interpolation="nearest")
-    fig.colorbar(im, ax=ax, label="travel (cells); darker = longer")
+    fig.colorbar(im, ax=ax, label="travel (cells); darker = longer; blue: not a start")
     ax.set_title(f"travel per start cell (Fig. 15): spread {100 * sp['spread']:.1f} %")
     files.append("sweeper_start_position.png")
     fig.savefig(out_dir / files[-1], dpi=100)

@@ -26,6 +26,9 @@ Choices where the paper is open (documented and tested):
 - A shift moves up to one sweeping width; a shorter shift (a wall nearer than
   ``w``) is still a shift. The run ends when no shift cell is free or the new
   lane holds nothing to sweep.
+- Where the segment one width away is blocked (a strip narrower than the
+  robot between the lane and a wall), the segment is moved back towards the
+  lane, one cell at a time, until a configuration along it is free.
 - A pushed entry keeps its whole side segment (start, heading, length, side):
   on popping, the restart point is the end of the segment's still-unswept
   part that is nearer to the robot (the paper's "start point" taken from
@@ -72,6 +75,18 @@ def side_segments(
         s = (start[0] + w * int(DR[side]), start[1] + w * int(DC[side]))
         out.append(Segment(s, heading, length, side))
     return out
+
+
+def toward_lane(seg: Segment, j: int) -> Segment:
+    """``seg`` moved ``j`` cells back towards the lane that pushed it.
+
+    A strip narrower than the robot between the lane and a wall cannot be
+    reached one full width away; the robot sweeps it from a position
+    overlapping the lane instead.
+    """
+    back = (seg.side + 2) % 4
+    start = (seg.start[0] + j * int(DR[back]), seg.start[1] + j * int(DC[back]))
+    return Segment(start, seg.heading, seg.length, seg.side)
 
 
 def segment_configs(seg: Segment) -> tuple[np.ndarray, np.ndarray]:

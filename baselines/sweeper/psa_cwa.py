@@ -207,7 +207,11 @@ class PsaCwaPolicy(ScriptedPolicy):
         if self.pop_order == "nearest":
             best, best_k = None, None
             for k, seg in enumerate(m.stack.items):
-                found = psa.first_target(seg, origin, dist >= 0, todo, dist)
+                found = None
+                for j in range(self.w):
+                    found = found or psa.first_target(
+                        psa.toward_lane(seg, j), origin, dist >= 0, todo, dist
+                    )
                 if found is not None:
                     d = dist[found[0][0] - origin[0], found[0][1] - origin[1]]
                     if best is None or d < best:
@@ -216,7 +220,10 @@ class PsaCwaPolicy(ScriptedPolicy):
                 m.stack.items.append(m.stack.items.pop(best_k))
         while len(m.stack):
             seg = m.stack.pop()
-            found = psa.first_target(seg, origin, dist >= 0, todo, dist)
+            for j in range(self.w):  # one width away, else closer to the lane
+                found = psa.first_target(psa.toward_lane(seg, j), origin, dist >= 0, todo, dist)
+                if found is not None:
+                    break
             if found is None:
                 continue  # already swept (the paper's skip) or out of reach
             target, heading = found

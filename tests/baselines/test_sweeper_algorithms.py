@@ -116,3 +116,15 @@ def test_cwa_leftovers_and_nearest_cover() -> None:
     assert left.sum() == 2 * 7 and left[4:6, 1:8].all()
     dist = world.bfs_distance(free, (1, 1))
     assert cwa.nearest_cover(dist, np.argwhere(left), 3) == (2, 1)  # one step south
+
+
+def test_toward_lane_moves_a_blocked_side_segment_back() -> None:
+    seg = psa.Segment((13, 5), 0, 11, 3)  # south of a lane at row 10
+    assert psa.toward_lane(seg, 0) == seg
+    assert psa.toward_lane(seg, 2) == psa.Segment((11, 5), 0, 11, 3)
+    # a one-row strip under the lane, then a wall: reachable only two rows back
+    cfree = np.zeros((20, 20), bool)
+    cfree[10:12, :] = True
+    todo = np.ones((20, 20), bool)
+    assert psa.first_target(seg, (0, 0), cfree, todo) is None
+    assert psa.first_target(psa.toward_lane(seg, 2), (0, 0), cfree, todo) == ((11, 5), 0)
