@@ -44,8 +44,10 @@ class SweeperEnv(gym.Env):
     ============= ======== ===================================================
     sensed        (S*S,)   obstacles sensed around the footprint (1.0; outside
                            the map counts as obstacle), world-aligned (row 0
-                           north): entry ``[i, j]`` is map cell
-                           ``(row - R + i, col - R + j)`` of the believed pose
+                           north): entry ``[i, j]`` is the cell at offset
+                           ``(i - R, j - R)`` from the footprint's top-left
+                           cell (at the true pose; the robot files it at
+                           its believed pose)
     swept         (S*S,)   the robot's own sweep map over the same window
                            (1.0: swept)
     pose          (4,)     believed pose: footprint top-left row, column
@@ -59,15 +61,15 @@ class SweeperEnv(gym.Env):
 
     Everything is float32 in [0, 1] except ``pose`` (rows/columns up to 256).
     The maps are coarse to keep the space small (2 K^2 numbers); a policy that
-    needs the full-resolution maps builds them from ``sensed``, ``swept`` and ``pose``,
-    as the scripted policies do. Without odometry noise the believed pose is
+    needs the full-resolution maps builds them from ``sensed``, ``swept``
+    and ``pose``, as the scripted policies do. Without odometry noise the believed pose is
     the true pose.
 
     ## Reward
     Three named terms, summed; each is in ``info`` as ``reward_<term>``:
 
-    - ``sweep``: ``sweep_reward * (newly swept reachable cells) / w`` (+1 per
-      cell of fresh lane by default)
+    - ``sweep``: ``sweep_reward * (newly swept reachable cells) / w`` (+1 for
+      a forward move onto fresh floor, by default)
     - ``time``: ``time_reward`` on every step (a step cost, negative)
     - ``bump``: ``bump_reward`` on a bump (negative)
 
@@ -89,9 +91,9 @@ class SweeperEnv(gym.Env):
     action) or ``slip_noise`` (relative std of each forward move's length),
     the true pose is continuous and drifts from the believed pose, which
     advances by exactly one cell per unblocked move. Sensing and sweeping
-    happen at the true pose (rounded to cells); the observation's ``sensed``
-    window is written into the robot's maps at the believed pose. The believed pose is
-    clipped to the map's extent. A move whose rounded true pose leaves the
+    happen at the true pose (rounded to cells); the robot files the
+    ``sensed`` window in its maps at the believed pose, so its maps drift.
+    The believed pose is clipped to the map's extent. A move whose rounded true pose leaves the
     reachable configurations is a bump.
 
     ## reset options
