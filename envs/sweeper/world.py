@@ -83,14 +83,20 @@ def entering_mask(dr: int, dc: int, w: int) -> np.ndarray:
     return ~((i >= 0) & (i < w) & (j >= 0) & (j < w))
 
 
-def smartdfs_bound(reachable: np.ndarray, w: int) -> tuple[int, int, float]:
+def smartdfs_bound(
+    reachable: np.ndarray, w: int, anchor: tuple[int, int] = (0, 0)
+) -> tuple[int, int, float]:
     """SmartDFS's travel bound ``C + E/2`` on the map, at robot scale.
 
-    The map is cut into ``w x w`` blocks; ``C`` counts blocks holding a
-    reachable cell and ``E`` the block edges between such a block and any
-    other (boundary edges). Returns ``(C, E, ratio)`` where ``ratio`` is the
-    bound in cells, ``w (C + E/2)``, divided by the lower bound ``area / w``.
+    The map is cut into ``w x w`` blocks, one of them at ``anchor`` (the
+    robot's start configuration: the grid the robot itself would explore);
+    ``C`` counts blocks holding a reachable cell and ``E`` the block edges
+    between such a block and any other (boundary edges). Returns
+    ``(C, E, ratio)`` where ``ratio`` is the bound in cells, ``w (C + E/2)``,
+    divided by the lower bound ``area / w``.
     """
+    top, left = (-anchor[0]) % w, (-anchor[1]) % w
+    reachable = np.pad(reachable, ((top, 0), (left, 0)))
     h, wd = reachable.shape
     hb, wb = -(-h // w), -(-wd // w)
     pad = np.zeros((hb * w, wb * w), dtype=bool)

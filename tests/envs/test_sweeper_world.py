@@ -133,3 +133,10 @@ def test_generator_fifty_maps_closed_with_room_for_robot() -> None:
     assert kinds == set(generator.KINDS)
     with pytest.raises(ValueError, match="unknown map kind"):
         generator.random_map(rng, 3, "castle")
+
+
+def test_smartdfs_bound_blocks_anchored_at_the_start() -> None:
+    reach = np.ones((12, 18), bool)
+    assert world.smartdfs_bound(reach, 3, (3, 6)) == world.smartdfs_bound(reach, 3)
+    c, e, _ = world.smartdfs_bound(reach, 3, (1, 1))  # blocks straddle the floor's edges
+    assert (c, e) == (35, 24)
