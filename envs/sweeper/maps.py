@@ -25,7 +25,7 @@ from scipy import ndimage
 
 from motiongym.envs.sweeper.world import is_closed
 
-MAPS_DIR = pathlib.Path(__file__).with_name("maps")
+MAPS_DIR = pathlib.Path(__file__).with_name("map_files")
 SHIPPED_MAPS = ("room", "apartment", "maze")
 MAX_SIDE = 256  # largest map side (cells) the observation space allows
 

@@ -1,0 +1,1 @@
+"""The shipped sweeper maps as text bitmaps (a package so that wheels carry them)."""
