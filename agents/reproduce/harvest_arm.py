@@ -18,6 +18,19 @@ every policy sees the same scenes: the paper's method (``potential-field``),
 the same with our two extensions of eq. 9-10 (``potential-field-extended``)
 and the plain resolved-rate baseline (``resolved-rate``).
 
+Where ours differ from the paper (full protocol, 200 trials per arm): the
+mean shortest axis distances agree (planar 0.075-0.083 m vs 0.067-0.080 m,
+spatial 0.082-0.095 m vs 0.078-0.100 m) and the spatial close approaches
+fall with DOF (about 10, 9, 6.5 % vs the paper's 6.5, 7.5, 1.5 %), but the
+planar ones stay near 13 % for 3, 4 and 5 DOF (paper 14, 7.5, 2.5 %). In our
+planar scenes almost every close approach happens on arrival, on the two
+links next to the gripper, against an obstacle about 0.2 m from the fruit
+that the gripper's path went round on the side away from the base: in the
+plane the arm's body cannot follow it round, whatever the DOF. The paper's
+scene distribution is not given; ours is documented in
+:mod:`motiongym.envs.harvest_arm.task`. The clearance (surface) figures are
+higher than the axis ones because links and obstacles have thickness.
+
 Printed: one table per paper table, the paper's run beside ours; written:
 ``harvest_arm.json`` (every number), ``harvest_arm_close_approaches.png``
 (% below 0.03 m per arm: paper, ours, baseline) and ``harvest_arm_fig8.png``
