@@ -8,6 +8,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from motiongym.envs.actions import checked_box_action
 from motiongym.envs.dual_arm import task as task_module
 from motiongym.envs.dual_arm.task import DT, TASK_MODES
 from motiongym.envs.dual_arm.world import OBS, DualArmWorld, observation_bounds
@@ -193,20 +194,10 @@ class DualArmCellEnv(gym.Env):
     # ------------------------------------------------------------------ helpers
 
     def _parse(self, action: Any) -> tuple[float, float]:
-        shape = self.action_space.shape
-        if isinstance(action, np.ndarray) and action.shape == shape:
-            a = action
-        else:
-            a = np.asarray(action, dtype=np.float64)
-            if a.shape != shape:
-                raise ValueError(
-                    f"action must have shape {shape} (control={self.control!r}), "
-                    f"got {np.shape(action)}"
-                )
-        values = [float(v) for v in a]
-        if any(v != v for v in values):
-            raise ValueError(f"action contains NaN: {a}")
-        values = [min(max(v, 0.0), 1.0) for v in values]
+        a = checked_box_action(
+            action, self.action_space.shape, f"advance per arm, control={self.control!r}"
+        )
+        values = [min(max(float(v), 0.0), 1.0) for v in a]
         if self.control == "both":
             return values[0], values[1]
         return 1.0, values[0]

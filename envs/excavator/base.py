@@ -36,6 +36,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from motiongym.envs.actions import checked_box_action
 from motiongym.envs.excavator import observation as obs_layout
 from motiongym.envs.excavator.config import Machine, machine_from_kwargs
 from motiongym.envs.excavator.kinematics import arm_points
@@ -173,14 +174,7 @@ class ExcavatorBase(gym.Env):
 
     # ------------------------------------------------------------------ step
     def step(self, action):
-        a = np.asarray(action, dtype=np.float64)
-        if a.shape != (4,):
-            raise ValueError(
-                f"action must have shape (4,) (swing, boom, stick, bucket), got {a.shape}"
-            )
-        values = a.tolist()
-        if not all(map(math.isfinite, values)):
-            raise ValueError(f"action must be finite, got {values}")
+        values = checked_box_action(action, (4,), "swing, boom, stick, bucket rates").tolist()
         if self.scene is None:
             raise RuntimeError("call reset() before step()")
         m, dt = self.m, self.dt

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import gymnasium as gym
@@ -10,6 +9,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from motiongym.envs.actions import checked_box_action
 from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec, build_model
 from motiongym.envs.harvest_arm.observation import DISTANCE_CLIP, ObservationLayout
 from motiongym.envs.harvest_arm.task import (
@@ -246,13 +246,7 @@ class HarvestArmEnv(gym.Env):
 
     # ------------------------------------------------------------------- step
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        a = np.asarray(action, dtype=np.float64)
-        if a.shape != self._action_shape:
-            raise ValueError(
-                f"action must have shape {self._action_shape} (one rate per joint), got {a.shape}"
-            )
-        if not math.isfinite(a.sum()):
-            raise ValueError(f"action must be finite (no NaN or inf), got {a}")
+        a = checked_box_action(action, self._action_shape, "one rate per joint")
         if self.scene is None:
             raise RuntimeError("call reset() before step()")
         a = np.minimum(np.maximum(a, -1.0), 1.0)
