@@ -28,18 +28,18 @@ from motiongym.envs.sweeper.world import DC, DR
 class BatchedGrids:
     """Per-environment padded maps as ``(N, L)`` arrays, and the offsets into them."""
 
-    def __init__(self, num_envs: int, w: int, R: int, shared: np.ndarray | None) -> None:
-        self.N, self.w, self.P, self.S = num_envs, w, R, w + 2 * R
+    def __init__(self, num_envs: int, w: int, R: int, K: int, shared: np.ndarray | None) -> None:
+        self.N, self.w, self.P, self.S, self.K = num_envs, w, R, w + 2 * R, K
         # shared: the fixed map of every sub-environment, stored once.
         self.shared = shared
         self.Hmax = self.Wmax = 0
         self.Hp = self.Wp = self.L = 0
-        self.obst_f = np.zeros((0, 0), np.float32)  # (1 or N, L) obstacle as 0/1 float
         self.obst_b = np.zeros((0, 0), bool)  # (1 or N, L) obstacle
         self.reach = np.zeros((num_envs, 0), bool)  # (N, L) reachable config at anchor
         self.cnt = np.zeros((num_envs, 0), np.uint8)  # (N, L) sweep count, saturates at 2
         self.known = np.zeros((num_envs, 0), bool)  # (N, L) obstacle cells sensed
-        self.obst_base = np.zeros(num_envs, np.int64)  # (N,) row start in obst_* (flat)
+        self.block = np.zeros((0, 0), np.int32)  # (1 or N, L) coarse block of a cell, -1 outside
+        self.obst_base = np.zeros(num_envs, np.int64)  # (N,) row start in obst_*, block (flat)
         if shared is not None:
             self.ensure(*shared.shape)
 
@@ -63,15 +63,33 @@ class BatchedGrids:
         self.known = grow(self.known, N, False)
         self.Hmax, self.Wmax, self.Hp, self.Wp, self.L = Hmax, Wmax, Hp, Wp, Hp * Wp
         if self.shared is not None:
-            pad = np.ones((Hp, Wp), bool)
-            pad[P : P + H, P : P + W] = self.shared
-            self.obst_b = pad.reshape(1, -1)
+            self.obst_b = self._pad(self.shared).reshape(1, -1)
+            self.block = self._blocks(*self.shared.shape).reshape(1, -1)
         else:
             self.obst_b = grow(self.obst_b, N, True)
+            self.block = grow(self.block, N, -1)
             self.obst_base = np.arange(N, dtype=np.int64) * self.L
-        self.obst_f = self.obst_b.astype(np.float32)
         self._offsets()
         return True
+
+    def _pad(self, obstacle: np.ndarray) -> np.ndarray:
+        """``(Hp, Wp)`` bool: the map in the padded layout, obstacles around it."""
+        H, W = obstacle.shape
+        pad = np.ones((self.Hp, self.Wp), bool)
+        pad[self.P : self.P + H, self.P : self.P + W] = obstacle
+        return pad
+
+    def _blocks(self, H: int, W: int) -> np.ndarray:
+        """``(Hp, Wp)`` int32: the coarse block (row-major in ``K x K``) of each map cell.
+
+        Blocks are ``ceil(H/K) x ceil(W/K)`` cells as in the single environment;
+        -1 marks cells outside the map (padding), which the coarse maps ignore.
+        """
+        K, P = self.K, self.P
+        bh, bw = -(-H // K), -(-W // K)
+        out = np.full((self.Hp, self.Wp), -1, np.int32)
+        out[P : P + H, P : P + W] = (np.arange(H) // bh)[:, None] * K + np.arange(W) // bw
+        return out
 
     def _offsets(self) -> None:
         w, P, S, Wp = self.w, self.P, self.S, self.Wp
@@ -89,17 +107,20 @@ class BatchedGrids:
         )
         fy, fx = np.divmod(np.arange(w * w), w)
         self.foot_off = ((fy + P) * Wp + fx + P).astype(np.int64)  # (w*w,) footprint
+        # Where the entering cells sit in the (S, S) window, per heading: (4, w) each.
+        self.enter_win = [
+            np.nonzero(world.entering_mask(int(DR[k]), int(DC[k]), w)) for k in range(4)
+        ]
+        self.enter_win = [(rr + P, cc + P) for rr, cc in self.enter_win]
 
     # ------------------------------------------------------------------- reset
     def load(self, i: int, obstacle: np.ndarray, reach_configs: np.ndarray) -> None:
         """Write sub-environment ``i``'s map; clear its sweep and sensing maps."""
         H, W = obstacle.shape
-        P, Hp, Wp = self.P, self.Hp, self.Wp
+        Hp, Wp = self.Hp, self.Wp
         if self.shared is None:
-            pad = np.ones((Hp, Wp), bool)
-            pad[P : P + H, P : P + W] = obstacle
-            self.obst_b[i] = pad.ravel()
-            self.obst_f[i] = self.obst_b[i]
+            self.obst_b[i] = self._pad(obstacle).ravel()
+            self.block[i] = self._blocks(H, W).ravel()
         reach = np.zeros((Hp, Wp), bool)
         reach[:H, :W] = reach_configs
         self.reach[i] = reach.ravel()
