@@ -286,7 +286,7 @@ def _print(results: dict) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    console = Console()
+    console = Console(width=120)
     t = Table(title="Sweeper: PSA + CWA coverage and travel (W = 3 cells)")
     for col in (
         "map",
