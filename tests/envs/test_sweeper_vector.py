@@ -1,0 +1,218 @@
+"""SweeperVectorEnv: step-for-step equal to SyncVectorEnv of SweeperEnv (same-step autoreset)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+
+import motiongym  # noqa: F401
+from motiongym.envs.sweeper.generator import empty_room
+from motiongym.envs.sweeper.vector_env import SweeperVectorEnv
+
+ENV_ID = "motiongym/Sweeper-v0"
+
+
+def assert_same(a, b, path: str = "") -> None:
+    """Exact equality of nested dicts / object arrays / arrays, dtypes included."""
+    if isinstance(a, (tuple, list)):
+        assert isinstance(b, (tuple, list)) and len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            assert_same(x, y, f"{path}[{i}]")
+    elif isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), (path, set(a) ^ set(b))
+        for key in a:
+            assert_same(a[key], b[key], f"{path}/{key}")
+    elif isinstance(a, np.ndarray) and a.dtype == object:
+        assert isinstance(b, np.ndarray) and b.dtype == object and a.shape == b.shape, path
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            assert (x is None) == (y is None), (path, i)
+            if x is not None:
+                assert_same(x, y, f"{path}[{i}]")
+    else:
+        a, b = np.asarray(a), np.asarray(b)
+        assert a.dtype == b.dtype and a.shape == b.shape, (path, a.dtype, b.dtype, a.shape, b.shape)
+        np.testing.assert_array_equal(a, b, err_msg=path)
+
+
+def sync_twin(num_envs: int, max_steps: int, **kwargs) -> SyncVectorEnv:
+    return SyncVectorEnv(
+        [lambda: gym.make(ENV_ID, max_episode_steps=max_steps, **kwargs)] * num_envs,
+        autoreset_mode=AutoresetMode.SAME_STEP,
+    )
+
+
+def compare(num_envs: int, max_steps: int, n_steps: int, seed: int, **kwargs) -> tuple[int, int]:
+    """Step both with the same random actions; return (terminations, truncations)."""
+    native = SweeperVectorEnv(num_envs=num_envs, max_episode_steps=max_steps, **kwargs)
+    sync = sync_twin(num_envs, max_steps, **kwargs)
+    assert_same(native.reset(seed=seed), sync.reset(seed=seed), "reset")
+    rng = np.random.default_rng(seed)
+    n_term = n_trunc = 0
+    for t in range(n_steps):
+        actions = rng.choice(3, size=num_envs, p=[0.6, 0.2, 0.2])
+        got, want = native.step(actions), sync.step(actions)
+        for name, x, y in zip(("obs", "reward", "term", "trunc", "info"), got, want, strict=True):
+            assert_same(x, y, f"step {t} {name}")
+        n_term += int(got[2].sum())
+        n_trunc += int(got[3].sum())
+    return n_term, n_trunc
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "num_envs", "max_steps", "n_steps"),
+    [
+        ({"grid": empty_room(8, 11)}, 4, 150, 800),  # terminations (full coverage) and truncations
+        ({"map_name": "room"}, 3, 70, 600),
+        ({"map_name": "maze", "robot_width": 2, "coarse": 8}, 2, 90, 400),
+        (
+            {"map_name": "apartment", "robot_width": 4, "sensor_range": 1, "sweep_reward": 2.0},
+            2,
+            80,
+            400,
+        ),
+        ({"map_name": "random-room"}, 5, 60, 300),  # maps of several shapes: the layout grows
+        ({"map_name": "random"}, 3, 50, 300),
+    ],
+)
+def test_step_for_step_equal_to_sync_vector_env(kwargs, num_envs, max_steps, n_steps) -> None:
+    n_term, n_trunc = compare(num_envs, max_steps, n_steps, seed=7, **kwargs)
+    assert n_trunc > 0
+    if "grid" in kwargs:
+        assert n_term > 0  # the small room gets fully swept by random actions
+
+
+def test_same_seed_same_trajectory_and_reseeding() -> None:
+    actions = np.random.default_rng(1).integers(0, 3, size=(300, 6))
+
+    def rollout(env: SweeperVectorEnv) -> list:
+        out = [env.reset(seed=11)]
+        out += [env.step(a) for a in actions]
+        return out
+
+    env = SweeperVectorEnv(num_envs=6, max_episode_steps=40, map_name="random-apartment")
+    first = rollout(env)
+    assert_same(first, rollout(env))  # the same env, reseeded
+    assert_same(first, rollout(SweeperVectorEnv(6, 40, map_name="random-apartment")))
+    # Sub-environment i is seeded with seed + i: different scenarios.
+    pose = first[0][0]["pose"]
+    assert len({tuple(p) for p in pose}) > 1
+
+
+def test_returned_observations_are_not_overwritten() -> None:
+    env = SweeperVectorEnv(num_envs=8, max_episode_steps=5)
+    obs, _ = env.reset(seed=0)
+    kept = {k: v.copy() for k, v in obs.items()}
+    view = obs["sweep_map"][2:4]
+    view_copy = view.copy()
+    rng = np.random.default_rng(0)
+    for _ in range(12):  # with autoresets
+        env.step(rng.integers(0, 3, size=8))
+    assert_same(obs, kept)
+    np.testing.assert_array_equal(view, view_copy)
+
+
+def test_spaces_and_metadata() -> None:
+    env = SweeperVectorEnv(num_envs=3, map_name="apartment", robot_width=2)
+    single = gym.make(ENV_ID, map_name="apartment", robot_width=2)
+    assert env.single_observation_space == single.observation_space
+    assert env.single_action_space == single.action_space
+    assert env.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    assert env.metadata["info_measures"] == single.unwrapped.metadata["info_measures"]
+    obs, _ = env.reset(seed=0)
+    assert env.observation_space.contains(obs)
+    obs, *_ = env.step(np.zeros(3, np.int64))
+    assert env.observation_space.contains(obs)
+
+
+def test_partial_reset_with_mask() -> None:
+    env = SweeperVectorEnv(num_envs=4)
+    sync = sync_twin(4, 20_000)
+    assert_same(env.reset(seed=3), sync.reset(seed=3))
+    actions = np.random.default_rng(0).integers(0, 3, size=(20, 4))
+    for a in actions:
+        assert_same(env.step(a), sync.step(a))
+    mask = np.array([False, True, False, True])
+    assert_same(
+        env.reset(seed=50, options={"reset_mask": mask}),
+        sync.reset(seed=50, options={"reset_mask": mask.copy()}),
+    )
+    for a in actions:
+        assert_same(env.step(a), sync.step(a))
+
+
+@pytest.mark.parametrize(
+    ("actions", "match"),
+    [
+        (np.zeros(3, np.int64), "shape"),
+        (np.zeros((4, 2), np.int64), "shape"),
+        (np.array([0, 1, 3, 0]), "sub-environment 2 got 3"),
+        (np.array([0, -1, 0, 0]), "sub-environment 1 got -1"),
+        (np.array([0.0, np.nan, 1.0, 2.0]), "NaN"),
+        (np.array([0.0, 0.5, 1.0, 2.0]), "integers"),
+        (np.array(["a", "b", "c", "d"]), "integers"),
+    ],
+)
+def test_bad_actions_raise(actions, match) -> None:
+    env = SweeperVectorEnv(num_envs=4)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=match):
+        env.step(actions)
+
+
+def test_bad_construction_raises() -> None:
+    with pytest.raises(ValueError, match="heading_noise"):
+        SweeperVectorEnv(num_envs=2, heading_noise=0.1)
+    with pytest.raises(ValueError, match="slip_noise"):
+        SweeperVectorEnv(num_envs=2, slip_noise=0.1)
+    with pytest.raises(ValueError, match="unknown map_name"):
+        SweeperVectorEnv(num_envs=2, map_name="castle")
+    with pytest.raises(ValueError, match="num_envs"):
+        SweeperVectorEnv(num_envs=0)
+    with pytest.raises(RuntimeError, match="reset"):
+        SweeperVectorEnv(num_envs=2).step(np.zeros(2, np.int64))
+
+
+def test_sb3_adapter_over_native_vector_env() -> None:
+    from motiongym.agents.vector import VectorEnvAdapter
+
+    venv = VectorEnvAdapter(SweeperVectorEnv(num_envs=4, max_episode_steps=6))
+    venv.seed(0)
+    obs = venv.reset()
+    assert obs["pose"].shape == (4, 4)
+    for t in range(6):
+        obs, rewards, dones, infos = venv.step(np.full(4, t % 3))
+        assert rewards.dtype == np.float32 and len(infos) == 4
+    assert dones.all()  # truncated at 6 steps
+    for info in infos:
+        assert info["TimeLimit.truncated"] is True
+        assert info["terminal_observation"]["pose"].shape == (4,)
+        assert info["steps"] == 6
+    assert (obs["pose"][:, 3] == 0).all()  # the new episodes' first observations
+
+
+def test_render_matches_single_env() -> None:
+    kwargs = {"grid": empty_room(8, 11), "render_mode": "rgb_array", "cell_pixels": 4}
+    env = SweeperVectorEnv(num_envs=2, max_episode_steps=30, **kwargs)
+    sync = sync_twin(2, 30, **kwargs)
+    env.reset(seed=2)
+    sync.reset(seed=2)
+    for a in np.random.default_rng(2).integers(0, 3, size=(20, 2)):
+        env.step(a)
+        sync.step(a)
+    for got, want in zip(env.render(), sync.render(), strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.skipif(
+    not gym.spec(ENV_ID).vector_entry_point, reason="vector_entry_point not registered yet"
+)
+def test_make_vec_vector_entry_point() -> None:
+    env = gym.make_vec(ENV_ID, num_envs=3, vectorization_mode="vector_entry_point")
+    assert isinstance(env.unwrapped, SweeperVectorEnv)
+    assert env.unwrapped.max_episode_steps == gym.spec(ENV_ID).max_episode_steps
+    sync = sync_twin(3, gym.spec(ENV_ID).max_episode_steps)
+    assert_same(env.reset(seed=5), sync.reset(seed=5))
+    for a in np.random.default_rng(5).integers(0, 3, size=(50, 3)):
+        assert_same(env.step(a), sync.step(a))
