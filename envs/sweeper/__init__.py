@@ -6,6 +6,7 @@ REGISTRATIONS: tuple[dict, ...] = (
     {
         "id": "motiongym/Sweeper-v0",
         "entry_point": "motiongym.envs.sweeper.env:SweeperEnv",
+        "vector_entry_point": "motiongym.envs.sweeper.vector_env:SweeperVectorEnv",
         "max_episode_steps": 20_000,
         "kwargs": {"map_name": "room", "robot_width": 3},
     },
