@@ -299,24 +299,25 @@ class SweeperVectorEnv(VectorEnv):
         # Observation windows: shift by the move, fill the leading edge and the
         # entering (now swept) cells; nothing else in a window changes.
         fill = np.stack([obst, (state & COUNT) != 0], axis=1)  # (M, 2, S)
-        win = self.win[moved]  # (M, 2, S, S)
+        old = self.win[moved]  # (M, 2, S, S)
+        win = np.empty_like(old)
         bounds = np.searchsorted(hm, np.arange(5))
         for k in range(4):
             lo, hi = bounds[k], bounds[k + 1]
             if lo == hi:
                 continue
-            part, f = win[lo:hi], fill[lo:hi]
+            part, was, f = win[lo:hi], old[lo:hi], fill[lo:hi]
             if k == 0:  # east: new[i, j] = old[i, j + 1]
-                part[..., :-1] = part[..., 1:]
+                part[..., :-1] = was[..., 1:]
                 part[..., -1] = f
             elif k == 1:  # north: new[i, j] = old[i - 1, j]
-                part[..., 1:, :] = part[..., :-1, :]
+                part[..., 1:, :] = was[..., :-1, :]
                 part[..., 0, :] = f
             elif k == 2:  # west: new[i, j] = old[i, j - 1]
-                part[..., 1:] = part[..., :-1]
+                part[..., 1:] = was[..., :-1]
                 part[..., 0] = f
             else:  # south: new[i, j] = old[i + 1, j]
-                part[..., :-1, :] = part[..., 1:, :]
+                part[..., :-1, :] = was[..., 1:, :]
                 part[..., -1, :] = f
             rr, cc = g.enter_win[k]
             part[:, 1, rr, cc] = 1.0
