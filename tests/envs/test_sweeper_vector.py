@@ -160,6 +160,18 @@ def test_partial_reset_with_mask() -> None:
         assert_same(env.step(a), sync.step(a))
 
 
+def test_reset_options_reach_every_sub_environment() -> None:
+    options = {"start": (2, 3), "heading": 1}
+    env, sync = SweeperVectorEnv(3, 30), sync_twin(3, 30)
+    got = env.reset(seed=0, options=options)
+    assert_same(got, sync.reset(seed=0, options=options))
+    assert (got[0]["pose"][:, :3] == [2, 3, 1]).all()
+    for a in np.random.default_rng(0).integers(0, 3, size=(40, 3)):  # autoresets: random again
+        assert_same(env.step(a), sync.step(a))
+    with pytest.raises(ValueError, match="unknown reset options"):
+        env.reset(options={"goal": 1})
+
+
 @pytest.mark.parametrize(
     ("actions", "match"),
     [
