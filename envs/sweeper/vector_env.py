@@ -12,7 +12,14 @@ from gymnasium.vector.utils import batch_space
 
 from motiongym.envs.sweeper import task
 from motiongym.envs.sweeper.env import SweeperEnv
-from motiongym.envs.sweeper.vector_state import COUNT, KNOWN, BatchedGrids, ObservationPool
+from motiongym.envs.sweeper.vector_state import (
+    COUNT,
+    KNOWN,
+    BatchedGrids,
+    ObservationPool,
+    check_actions,
+    spread_info,
+)
 from motiongym.envs.sweeper.world import DC, DR
 
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
@@ -170,7 +177,7 @@ class SweeperVectorEnv(VectorEnv):
         zeros = np.zeros(len(idx))
         info = self._info(idx, zeros, 0.0, zeros, np.zeros(len(idx), bool))
         if mask is not None:
-            info = _spread(info, idx, N)
+            info = spread_info(info, idx, N)
         self._pool.record(None)
         return self._observation(), info
 
@@ -221,7 +228,7 @@ class SweeperVectorEnv(VectorEnv):
     def step(self, actions: Any) -> tuple[dict, np.ndarray, np.ndarray, np.ndarray, dict]:
         if not self._ready:
             raise RuntimeError("call reset() before step()")
-        a = self._check_actions(actions)
+        a = check_actions(actions, self.num_envs)
         g, N, L = self._grids, self.num_envs, self._grids.L
         self.steps += 1
         fwd = np.flatnonzero(a == 0)
@@ -358,35 +365,6 @@ class SweeperVectorEnv(VectorEnv):
         info["final_obs"], info["_final_obs"] = final_obs, done.copy()
         info["final_info"], info["_final_info"] = final_info, done.copy()
 
-    def _check_actions(self, actions: Any) -> np.ndarray:
-        a = np.asarray(actions)
-        N = self.num_envs
-        if a.shape not in ((N,), (N, 1)):
-            raise ValueError(
-                f"actions must have shape ({N},): one of 0 (forward), 1 (left), 2 (right) "
-                f"per sub-environment; got shape {a.shape}"
-            )
-        a = a.reshape(N)
-        if a.dtype.kind not in "iu":
-            if a.dtype.kind not in "fb":
-                raise ValueError(f"actions must be integers in {{0, 1, 2}}, got dtype {a.dtype}")
-            if a.dtype.kind == "f":
-                if np.isnan(a).any():
-                    raise ValueError(
-                        f"actions contain NaN at indices {np.flatnonzero(np.isnan(a))}"
-                    )
-                if (a != np.round(a)).any():
-                    raise ValueError("actions must be integers in {0, 1, 2}, got fractional values")
-            a = a.astype(np.int64)
-        bad = (a < 0) | (a > 2)
-        if bad.any():
-            k = int(np.flatnonzero(bad)[0])
-            raise ValueError(
-                "actions must be 0 (forward), 1 (left) or 2 (right); "
-                f"sub-environment {k} got {a[k]}"
-            )
-        return a
-
     # ---------------------------------------------------------------- outputs
     def _observation(self, idx: np.ndarray | None = None) -> dict:
         """Observation of worlds ``idx`` (fresh arrays), or of all (pooled arrays)."""
@@ -473,16 +451,3 @@ class SweeperVectorEnv(VectorEnv):
             )
             frames.append(draw(view, self._single.cell_pixels))
         return tuple(frames)
-
-
-def _spread(info: dict, idx: np.ndarray, N: int) -> dict:
-    """Info of worlds ``idx`` -> full ``(N,)`` arrays, zero and unmasked elsewhere."""
-    out = {}
-    for key, value in info.items():
-        full = np.zeros((N, *value.shape[1:]), value.dtype)
-        full[idx] = value
-        if key.startswith("_"):
-            full[:] = False
-            full[idx] = True
-        out[key] = full
-    return out

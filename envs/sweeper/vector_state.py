@@ -17,7 +17,8 @@ grow (rare: the generators' sides are bounded); the added cells lie beyond
 every existing window, so growing changes nothing else.
 
 :class:`ObservationPool` hands out the observation arrays of the vector env
-(see its docstring).
+(see its docstring); :func:`check_actions` validates a batch of actions and
+:func:`spread_info` lays a partial reset's info out as SyncVectorEnv does.
 """
 
 from __future__ import annotations
@@ -170,6 +171,46 @@ class ObservationPool:
         if len(self.sets) < self.max_sets and hasattr(sys, "getrefcount"):
             self.sets.append((arrays, [self.version]))
         return arrays, None
+
+
+def check_actions(actions: Any, N: int) -> np.ndarray:
+    """``(N,)`` int actions in {0, 1, 2}; ValueError naming the problem otherwise."""
+    a = np.asarray(actions)
+    if a.shape not in ((N,), (N, 1)):
+        raise ValueError(
+            f"actions must have shape ({N},): one of 0 (forward), 1 (left), 2 (right) "
+            f"per sub-environment; got shape {a.shape}"
+        )
+    a = a.reshape(N)
+    if a.dtype.kind not in "iu":
+        if a.dtype.kind not in "fb":
+            raise ValueError(f"actions must be integers in {{0, 1, 2}}, got dtype {a.dtype}")
+        if a.dtype.kind == "f":
+            if np.isnan(a).any():
+                raise ValueError(f"actions contain NaN at indices {np.flatnonzero(np.isnan(a))}")
+            if (a != np.round(a)).any():
+                raise ValueError("actions must be integers in {0, 1, 2}, got fractional values")
+        a = a.astype(np.int64)
+    bad = (a < 0) | (a > 2)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ValueError(
+            f"actions must be 0 (forward), 1 (left) or 2 (right); sub-environment {k} got {a[k]}"
+        )
+    return a
+
+
+def spread_info(info: dict, idx: np.ndarray, N: int) -> dict:
+    """Info of worlds ``idx`` -> full ``(N,)`` arrays, zero and unmasked elsewhere."""
+    out = {}
+    for key, value in info.items():
+        full = np.zeros((N, *value.shape[1:]), value.dtype)
+        full[idx] = value
+        if key.startswith("_"):
+            full[:] = False
+            full[idx] = True
+        out[key] = full
+    return out
 
 
 def _most_refs(arrays: dict[str, np.ndarray]) -> int:
