@@ -83,6 +83,36 @@ def test_step_for_step_equal_to_sync_vector_env(kwargs, num_envs, max_steps, n_s
         assert n_term > 0  # the small room gets fully swept by random actions
 
 
+@pytest.mark.parametrize("map_name", ["room", "random-room"])
+def test_full_coverage_episodes_with_the_scripted_policy(map_name: str) -> None:
+    """PSA+CWA sweeps whole maps: terminations by success, compared step for step."""
+    from motiongym.baselines.registry import make_policy
+
+    native, sync = (
+        SweeperVectorEnv(4, 3000, map_name=map_name),
+        sync_twin(4, 3000, map_name=map_name),
+    )
+    policy = make_policy(
+        ENV_ID,
+        "psa-cwa",
+        native.single_observation_space,
+        native.single_action_space,
+        {"map_name": map_name},
+    )
+    got = native.reset(seed=1)
+    assert_same(got, sync.reset(seed=1))
+    obs, start, successes = got[0], np.ones(4, bool), 0
+    for t in range(4000):
+        actions, _ = policy.predict(obs, episode_start=start)
+        got, want = native.step(actions), sync.step(actions)
+        assert_same(got, want, f"step {t}")
+        obs, start = got[0], got[2] | got[3]
+        successes += int(got[4].get("final_info", {}).get("is_success", np.zeros(4))[got[2]].sum())
+        if successes >= 5:
+            break
+    assert successes >= 5
+
+
 def test_same_seed_same_trajectory_and_reseeding() -> None:
     actions = np.random.default_rng(1).integers(0, 3, size=(300, 6))
 
