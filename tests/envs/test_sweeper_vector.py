@@ -276,3 +276,21 @@ def test_make_vec_vector_entry_point() -> None:
     assert_same(env.reset(seed=5), sync.reset(seed=5))
     for a in np.random.default_rng(5).integers(0, 3, size=(50, 3)):
         assert_same(env.step(a), sync.step(a))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("kwargs", "num_envs", "max_steps"),
+    [
+        ({"map_name": "room", "robot_width": 1, "sensor_range": 1}, 6, 300),
+        ({"map_name": "apartment", "coarse": 64}, 4, 500),
+        ({"map_name": "maze", "coarse": 1, "sensor_range": 6}, 4, 400),
+        ({"map_name": "random-maze", "robot_width": 2}, 6, 200),
+        ({"map_name": "random-apartment", "robot_width": 5, "sensor_range": 2}, 6, 200),
+        ({"map_name": "random", "time_reward": -0.3, "bump_reward": -2.5}, 8, 150),
+    ],
+)
+def test_long_runs_equal_to_sync_vector_env(kwargs, num_envs, max_steps) -> None:
+    """Edge widths, sensor ranges and coarse resolutions over thousands of steps."""
+    _, n_trunc = compare(num_envs, max_steps, 3000, seed=123, **kwargs)
+    assert n_trunc > 0
