@@ -139,7 +139,7 @@ class SweeperVectorEnv(VectorEnv):
         self.sw_obs = np.zeros((N, KK), np.float32)  # csw * inv_block, kept current
         self.ob_obs = np.zeros((N, KK), np.float32)  # cob * inv_block, kept current
         S = self.S
-        self.win = np.zeros((N, 2, S, S), np.float32)  # windows [sensed, swept], kept current
+        self.win = np.zeros((N, 2, S, S), np.uint8)  # windows [sensed, swept] (0/1), kept current
         self._rngs: list[np.random.Generator | None] = [None] * N
         self._scenarios: list[task.Scenario | None] = [None] * N
         self._paths: list[list[tuple[int, int]]] = [[] for _ in range(N)]
@@ -327,7 +327,7 @@ class SweeperVectorEnv(VectorEnv):
                 part[..., :-1, :] = was[..., 1:, :]
                 part[..., -1, :] = f
             rr, cc = g.enter_win[k]
-            part[:, 1, rr, cc] = 1.0
+            part[:, 1, rr, cc] = 1
         self.win[moved] = win
         changes["rows"].append(moved)
         if self.render_mode is not None:
@@ -372,8 +372,8 @@ class SweeperVectorEnv(VectorEnv):
         if idx is not None:
             pose = np.stack([self.r[idx], self.c[idx], self.h[idx], self.bump[idx]], axis=1)
             return {
-                "sensed": self.win[idx, 0].reshape(-1, SS),
-                "swept": self.win[idx, 1].reshape(-1, SS),
+                "sensed": self.win[idx, 0].reshape(-1, SS).astype(np.float32),
+                "swept": self.win[idx, 1].reshape(-1, SS).astype(np.float32),
                 "pose": pose.astype(np.float32),
                 "sweep_map": self.sw_obs[idx],
                 "obstacle_map": self.ob_obs[idx],
