@@ -284,12 +284,14 @@ class SweeperVectorEnv(VectorEnv):
         count = before & COUNT
         cell[cells] = before + (count < 2)
         fresh = count == 0
-        new = fresh.sum(axis=1)
+        new = np.einsum("ij->i", fresh.view(np.uint8))  # row sums of small (M, w)
         self.n_swept[moved] += new
-        self.n_over[moved] += (count == 1).sum(axis=1)
+        self.n_over[moved] += np.einsum("ij->i", (count == 1).view(np.uint8))
         if new.any():
-            target = (moved[:, None] * KK + g.block.ravel()[at_map + enter])[fresh]
-            self._count(self.csw, self.sw_obs, target)
+            ri, ci = np.nonzero(fresh)
+            env = moved[ri]
+            target = env * KK + g.block.ravel()[at_map[ri, 0] + enter[ri, ci]]
+            self._count(self.csw, self.sw_obs, env, target)
             changes["sweep"].append(target)
         # Sense the window's leading edge (the only cells new to it).
         edge = g.edge_off[hm]  # (M, S)
@@ -297,11 +299,14 @@ class SweeperVectorEnv(VectorEnv):
         state = cell[at_cell + edge]
         seen = obst & (state < KNOWN)
         if seen.any():
-            cell[(at_cell + edge)[seen]] = state[seen] | KNOWN
-            blocks = g.block.ravel()[(at_map + edge)[seen]]
-            env = np.broadcast_to(moved[:, None], seen.shape)[seen]
-            target = (env * KK + blocks)[blocks >= 0]
-            self._count(self.cob, self.ob_obs, target)
+            ri, ci = np.nonzero(seen)
+            e = edge[ri, ci]
+            cell[at_cell[ri, 0] + e] = state[ri, ci] | KNOWN
+            blocks = g.block.ravel()[at_map[ri, 0] + e]
+            inside = blocks >= 0
+            env = moved[ri[inside]]
+            target = env * KK + blocks[inside]
+            self._count(self.cob, self.ob_obs, env, target)
             changes["obst"].append(target)
         # Observation windows: shift by the move, fill the leading edge and the
         # entering (now swept) cells; nothing else in a window changes.
@@ -336,11 +341,13 @@ class SweeperVectorEnv(VectorEnv):
                 self._paths[i].append((r, c))
         return moved, new
 
-    def _count(self, counts: np.ndarray, scaled: np.ndarray, target: np.ndarray) -> None:
-        """Add one to coarse ``counts`` at flat ``target`` (repeats add up); rescale."""
+    def _count(
+        self, counts: np.ndarray, scaled: np.ndarray, env: np.ndarray, target: np.ndarray
+    ) -> None:
+        """Add one to coarse ``counts`` at flat ``target`` of worlds ``env``; rescale."""
         flat = counts.ravel()
-        np.add.at(flat, target, np.ones(len(target), np.float32))
-        scaled.ravel()[target] = flat[target] * self.inv_block[target // (self.K * self.K)]
+        np.add.at(flat, target, np.ones(len(target), np.float32))  # repeats add up
+        scaled.ravel()[target] = flat[target] * self.inv_block[env]
 
     def _autoreset(
         self, di: np.ndarray, done: np.ndarray, obs: dict, info: dict, changes: dict
