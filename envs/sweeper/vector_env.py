@@ -82,7 +82,8 @@ class SweeperVectorEnv(VectorEnv):
     copies). Once dropped, their memory is reused for a later observation and
     only the changed parts are written
     (:class:`~motiongym.envs.sweeper.vector_state.ObservationPool`): copy an
-    observation before modifying it in place.
+    observation before modifying it in place, or set the class attribute
+    ``recycle_observations = False`` for fresh arrays on every call.
 
     ``render()`` returns one frame per sub-environment (the robot's path is
     recorded only when ``render_mode="rgb_array"``).
@@ -94,6 +95,7 @@ class SweeperVectorEnv(VectorEnv):
         "autoreset_mode": AutoresetMode.SAME_STEP,
         "info_measures": dict(SweeperEnv.metadata["info_measures"]),
     }
+    recycle_observations = True  # False: fresh observation arrays on every call (slower)
 
     def __init__(
         self,
@@ -143,7 +145,7 @@ class SweeperVectorEnv(VectorEnv):
         self._rngs: list[np.random.Generator | None] = [None] * N
         self._scenarios: list[task.Scenario | None] = [None] * N
         self._paths: list[list[tuple[int, int]]] = [[] for _ in range(N)]
-        self._pool = ObservationPool(self.observation_space)
+        self._pool = ObservationPool(self.observation_space, 4 if self.recycle_observations else 0)
         self._ready = False
 
     # ------------------------------------------------------------------ reset

@@ -161,6 +161,20 @@ def test_recycled_observations_equal_sync_whatever_is_held() -> None:
         assert_same(mine, theirs)
 
 
+def test_without_recycling_every_observation_is_fresh(monkeypatch) -> None:
+    monkeypatch.setattr(SweeperVectorEnv, "recycle_observations", False)
+    native, sync = SweeperVectorEnv(3, 25), sync_twin(3, 25)
+    first = native.reset(seed=9)
+    assert_same(first, sync.reset(seed=9))
+    actions = np.random.default_rng(9).integers(0, 3, size=(60, 3))
+    previous = first[0]
+    for a in actions:
+        got = native.step(a)
+        assert_same(got, sync.step(a))
+        assert all(got[0][k] is not previous[k] for k in got[0])
+        previous = got[0]
+
+
 def test_spaces_and_metadata() -> None:
     env = SweeperVectorEnv(num_envs=3, map_name="apartment", robot_width=2)
     single = gym.make(ENV_ID, map_name="apartment", robot_width=2)
