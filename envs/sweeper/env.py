@@ -10,6 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.sweeper import maps, task, world
+from motiongym.envs.sweeper.measures import reward_terms, step_info
 from motiongym.envs.sweeper.world import DC, DR
 
 FORWARD, LEFT, RIGHT = 0, 1, 2
@@ -241,7 +242,7 @@ class SweeperEnv(gym.Env):
         self.n_swept = w * w
         self._mark_believed(np.arange(w).repeat(w) + self.br, np.tile(np.arange(w), w) + self.bc)
         self._sense()
-        info = self._info(0.0, 0.0, 0.0, False)
+        info = self._info((0.0, 0.0, 0.0), False)
         return self._obs(False), info
 
     # ------------------------------------------------------------------- step
@@ -261,11 +262,12 @@ class SweeperEnv(gym.Env):
                 self.err += float(self.np_random.normal(0.0, self.heading_noise))
         if a == FORWARD and not bump:  # a turn or a bump leaves the window unchanged
             self._sense(None if self.noisy else self.h)
-        r_sweep = self.sweep_reward * new / self.w
-        r_bump = self.bump_reward if bump else 0.0
-        reward = r_sweep + self.time_reward + r_bump
+        rewards = reward_terms(
+            new, bump, self.w, self.sweep_reward, self.time_reward, self.bump_reward
+        )
+        reward = sum(rewards)
         terminated = self.n_swept >= self.n_reach
-        info = self._info(r_sweep, self.time_reward, r_bump, bump)
+        info = self._info(rewards, bump)
         return self._obs(bump), float(reward), terminated, False, info
 
     def _check_action(self, action: Any) -> int:
@@ -386,22 +388,19 @@ class SweeperEnv(gym.Env):
             "obstacle_map": (self.coarse_obst * self.inv_block).ravel(),
         }
 
-    def _info(self, r_sweep: float, r_time: float, r_bump: float, bump: bool) -> dict:
-        n = self.n_reach
-        return {
-            "is_success": self.n_swept >= n,
-            "cost": 1.0 if bump else 0.0,
-            "coverage": self.n_swept / n,
-            "travel": self.travel,
-            "travel_ratio": self.travel * self.w / n,
-            "overlap": self.n_over / n,
-            "turns": self.turns,
-            "bumps": self.bumps,
-            "steps": self.steps,
-            "reward_sweep": r_sweep,
-            "reward_time": r_time,
-            "reward_bump": r_bump,
-        }
+    def _info(self, rewards: tuple[float, float, float], bump: bool) -> dict:
+        return step_info(
+            self.n_swept,
+            self.n_reach,
+            self.n_over,
+            self.travel,
+            self.turns,
+            self.bumps,
+            self.steps,
+            self.w,
+            bump,
+            rewards,
+        )
 
     # ----------------------------------------------------------------- render
     def render(self) -> np.ndarray | None:

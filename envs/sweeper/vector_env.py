@@ -12,6 +12,7 @@ from gymnasium.vector.utils import batch_space
 
 from motiongym.envs.sweeper import task
 from motiongym.envs.sweeper.env import SweeperEnv
+from motiongym.envs.sweeper.measures import INFO_KEYS, reward_terms, step_info
 from motiongym.envs.sweeper.vector_state import (
     COUNT,
     KNOWN,
@@ -23,20 +24,6 @@ from motiongym.envs.sweeper.vector_state import (
 from motiongym.envs.sweeper.world import DC, DR
 
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
-INFO_KEYS = (
-    "is_success",
-    "cost",
-    "coverage",
-    "travel",
-    "travel_ratio",
-    "overlap",
-    "turns",
-    "bumps",
-    "steps",
-    "reward_sweep",
-    "reward_time",
-    "reward_bump",
-)
 
 
 class SweeperVectorEnv(VectorEnv):
@@ -177,7 +164,7 @@ class SweeperVectorEnv(VectorEnv):
         self._reset_envs(idx, [seeds[i] for i in idx], options or None)
         self._ready = True
         zeros = np.zeros(len(idx))
-        info = self._info(idx, zeros, 0.0, zeros, np.zeros(len(idx), bool))
+        info = self._info(idx, (zeros, 0.0, zeros), np.zeros(len(idx), bool))
         if mask is not None:
             info = spread_info(info, idx, N)
         self._pool.record(None)
@@ -249,12 +236,13 @@ class SweeperVectorEnv(VectorEnv):
             moved, count = self._move(fwd[ok], hf[ok], na[ok], changes)
             new[moved] = count
         single = self._single
-        r_sweep = single.sweep_reward * new / self.w
-        r_bump = np.where(bump, single.bump_reward, 0.0)
-        reward = r_sweep + single.time_reward + r_bump
+        rewards = reward_terms(
+            new, bump, self.w, single.sweep_reward, single.time_reward, single.bump_reward
+        )
+        reward = rewards[0] + rewards[1] + rewards[2]
         terminated = self.n_swept >= self.n_reach
         truncated = self.steps >= self.max_episode_steps
-        info = self._info(slice(None), r_sweep, single.time_reward, r_bump, bump)
+        info = self._info(slice(None), rewards, bump)
         self._pool.record(changes)
         obs = self._observation()
         done = terminated | truncated
@@ -366,7 +354,7 @@ class SweeperVectorEnv(VectorEnv):
         self._reset_envs(di, [None] * len(di), None)
         changes["reset"].append(di)
         zeros = np.zeros(len(di))
-        fresh = self._info(di, zeros, 0.0, zeros, np.zeros(len(di), bool))
+        fresh = self._info(di, (zeros, 0.0, zeros), np.zeros(len(di), bool))
         for key in INFO_KEYS:
             info[key][di] = fresh[key]
         for key, value in self._observation(di).items():
@@ -411,26 +399,20 @@ class SweeperVectorEnv(VectorEnv):
                 dst[rows] = src[rows]
         return dict(out)
 
-    def _info(self, idx: Any, r_sweep: Any, r_time: float, r_bump: Any, bump: np.ndarray) -> dict:
-        n = self.n_reach[idx]
-        n_swept = self.n_swept[idx]
-        travel = self.travel[idx]
-        size = len(n)
-        mask = np.ones(size, bool)
-        info = {
-            "is_success": n_swept >= n,
-            "cost": bump.astype(np.float64),
-            "coverage": n_swept / n,
-            "travel": travel.copy(),
-            "travel_ratio": travel * self.w / n,
-            "overlap": self.n_over[idx] / n,
-            "turns": self.turns[idx].copy(),
-            "bumps": self.bumps[idx].copy(),
-            "steps": self.steps[idx].copy(),
-            "reward_sweep": np.asarray(r_sweep, np.float64),
-            "reward_time": np.full(size, r_time, np.float64),
-            "reward_bump": np.asarray(r_bump, np.float64),
-        }
+    def _info(self, idx: Any, rewards: tuple[Any, float, Any], bump: np.ndarray) -> dict:
+        info = step_info(
+            self.n_swept[idx],
+            self.n_reach[idx],
+            self.n_over[idx],
+            self.travel[idx],
+            self.turns[idx],
+            self.bumps[idx],
+            self.steps[idx],
+            self.w,
+            bump,
+            rewards,
+        )
+        mask = np.ones(len(info["coverage"]), bool)
         for key in INFO_KEYS:
             info[f"_{key}"] = mask.copy()
         return info
