@@ -30,7 +30,7 @@ import gymnasium as gym
 import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
-from motiongym.baselines.sweeper.run import make_policy, run_episode
+from motiongym.baselines.sweeper.run import make_policy, run_episode, smartdfs_ratio
 from motiongym.envs.sweeper import generator, maps, world
 
 ENV_ID = "motiongym/Sweeper-v0"
@@ -57,9 +57,17 @@ def _episode(env: gym.Env, policy: str, seed: int | None, options=None, max_step
 
 
 def _bound(env: gym.Env) -> float:
-    """SmartDFS ratio of the episode just run, blocks anchored at the robot's start."""
+    """SmartDFS ratio ``W (C + E/2 - 3) / (area / W)`` of the episode just run (blocks
+    anchored at the robot's start)."""
     sc = env.unwrapped.scenario
-    return world.smartdfs_bound(sc.reachable, W, sc.start)[2]
+    return smartdfs_ratio(sc.reachable, W, sc.start)
+
+
+def _shares(runs: list[dict]) -> dict[str, float]:
+    """Share of the travel spent per mode group (lane, shift, transfer, cwa), over ``runs``."""
+    total = sum(r["travel"] for r in runs) or 1.0
+    keys = ("lane", "shift", "transfer", "cwa")
+    return {k: sum(r["travel_by_mode"][k] for r in runs) / total for k in keys}
 
 
 def coverage_study(quick: bool) -> dict:
@@ -87,6 +95,7 @@ def coverage_study(quick: bool) -> dict:
             "nearest_first_ratio_mean": float(np.mean(nearest)),
             "nearest_first_below_smartdfs": int(np.sum(np.array(nearest) < np.array(bounds))),
             "overlap_mean": float(np.mean([r["overlap"] for r in runs])),
+            "travel_shares": _shares(runs),
             "turns_mean": float(np.mean([r["turns"] for r in runs])),
             "steps_mean": float(np.mean([r["steps"] for r in runs])),
             "wall_s_mean": float(np.mean([r["wall_s"] for r in runs])),
@@ -103,6 +112,7 @@ def coverage_study(quick: bool) -> dict:
         "all_swept": int(sum(r["is_success"] for r in runs)),
         "travel_ratio_mean": float(np.mean([r["travel_ratio"] for r in runs])),
         "below_smartdfs": int(below),
+        "travel_shares": _shares(runs),
     }
     return out
 
@@ -282,6 +292,10 @@ def _figures(out_dir: pathlib.Path, results: dict) -> list[str]:
     return files
 
 
+def _share_text(shares: dict[str, float]) -> str:
+    return "/".join(f"{100 * shares[k]:.0f}" for k in ("lane", "shift", "transfer", "cwa"))
+
+
 def _print(results: dict) -> None:
     from rich.console import Console
     from rich.table import Table
@@ -296,6 +310,7 @@ def _print(results: dict) -> None:
         "SmartDFS ratio mean",
         "episodes below",
         "nearest-first",
+        "lane/shift/transfer/cwa %",
     ):
         t.add_column(col)
     for name, row in results["coverage"].items():
@@ -309,6 +324,7 @@ def _print(results: dict) -> None:
             f"{row['smartdfs_ratio_mean']:.2f}",
             f"{row['below_smartdfs']}/{row['episodes']}",
             f"{row['nearest_first_ratio_mean']:.2f} ({row['nearest_first_below_smartdfs']} below)",
+            _share_text(row["travel_shares"]),
         )
     p = results["coverage"]["procedural"]
     t.add_row(
@@ -319,11 +335,13 @@ def _print(results: dict) -> None:
         "",
         f"{p['below_smartdfs']}/{p['episodes']}",
         "",
+        _share_text(p["travel_shares"]),
     )
     console.print(t)
     console.print(
         "paper: full coverage of Fig. 6, 11 and 12 whatever the obstacles. ratio: travel / "
-        "(area / W); SmartDFS: W (C + E/2) / (area / W), blocks anchored at the start; "
+        "(area / W); SmartDFS: W (C + E/2 - 3) / (area / W), W x W blocks anchored at the "
+        "start; "
         "nearest-first: an ablation (psa-cwa-nearest), not the paper's stack order"
     )
 

@@ -22,7 +22,11 @@ Choices where the paper is open (documented and tested):
 - "Right or left, alternating" relative to the heading is a constant side in
   the map frame: the run's *shift side*. The first run shifts to the right of
   the start heading; a run restarted from a popped segment shifts away from
-  the lane that pushed it.
+  the lane that pushed it. The alternation starts at the run's first shift:
+  where that side is closed at the end of the run's first lane (a wall right
+  beside it) or holds nothing to sweep, the run shifts to the other side and
+  keeps that side. (Without this, a robot started along a wall ended its
+  first run after one lane and left the open side to the stack's bottom.)
 - A shift moves up to one sweeping width; a shorter shift (a wall nearer than
   ``w``) is still a shift. The run ends when no shift cell is free or the new
   lane holds nothing to sweep.
@@ -36,6 +40,15 @@ Choices where the paper is open (documented and tested):
   the nearest point first), and the run sweeps towards the other end. When
   only the start point is stored, a segment whose start was swept later but
   whose far end was not would be skipped.
+- A popped segment that yields a restart point goes back on the stack, under
+  everything the new run pushes: the paper pushes a point "when the side
+  segment holds unswept cells", and after the run the segment may still hold
+  some (its unswept part was cut by an obstacle or by swept floor, and the
+  run sweeps only the piece it started on). It is popped again, LIFO, once
+  the new run's own segments are done, and skipped when swept. Each restart
+  sweeps at least the cell that made its point a target, so this ends.
+  (Dropping the segment lost those pieces until CWA's scan found them,
+  usually from the far side of the map.)
 """
 
 from __future__ import annotations

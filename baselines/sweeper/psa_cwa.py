@@ -52,6 +52,7 @@ class Memory:
     run_heading: int | None = None
     run_side: int | None = None
     lane_start: tuple[int, int] | None = None
+    first_lane: bool = True  # no shift yet in this run (its side may still flip)
     stack: psa.PsaStack = field(default_factory=psa.PsaStack)
     cwa_stack: list = field(default_factory=list)
     cwa_cells: np.ndarray | None = None
@@ -67,6 +68,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     pop_order = "lifo"
     restart_wide = True  # a wide leftover restarts PSA instead of corner work
     slide_back = False  # shift further back along the lane when blocked at its end
+    repush = True  # a popped segment goes back under the run it starts
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
@@ -138,8 +140,31 @@ class PsaCwaPolicy(ScriptedPolicy):
             if self._strip_unswept(m, seg):
                 m.stack.push(seg)
         # step 4: shift one width to the run's side, at the blocking point or,
-        # where the side is blocked there, at the nearest point back along the lane
-        s, back = m.run_side, (h + 2) % 4
+        # where the side is blocked there, at the nearest point back along the lane;
+        # a run's first shift may take the other side when the run's side is closed
+        back = (h + 2) % 4
+        sides = (m.run_side, (m.run_side + 2) % 4) if m.first_lane else (m.run_side,)
+        for s in sides:
+            plan = self._plan_shift(m, r, c, h, s)
+            if plan is not None:
+                break
+        if plan is None:
+            m.mode = "pop"
+            return None
+        j, base, k = plan
+        path = [(r + i * int(DR[back]), c + i * int(DC[back])) for i in range(1, j + 1)]
+        path += [(base[0] + i * int(DR[s]), base[1] + i * int(DC[s])) for i in range(1, k + 1)]
+        m.path = deque(path)
+        m.goal, m.run_heading, m.run_side, m.mode = path[-1], back, s, "shift"
+        m.first_lane = False
+        return None
+
+    def _plan_shift(
+        self, m: Memory, r: int, c: int, h: int, s: int
+    ) -> tuple[int, tuple[int, int], int] | None:
+        """Step 4 towards side ``s``: ``(j, base, k)``, a shift of ``k`` cells from ``j``
+        cells back along the lane, or None when no shift leads to a lane with work."""
+        back = (h + 2) % 4
         lane_len = abs(r - m.lane_start[0]) + abs(c - m.lane_start[1])
         plan = None
         for j in range(0, lane_len + 1 if self.slide_back else 1):  # pragma: no branch
@@ -152,15 +177,7 @@ class PsaCwaPolicy(ScriptedPolicy):
                 plan = (j, base, k)
             if k == self.w:
                 break
-        if plan is None:
-            m.mode = "pop"
-            return None
-        j, base, k = plan
-        path = [(r + i * int(DR[back]), c + i * int(DC[back])) for i in range(1, j + 1)]
-        path += [(base[0] + i * int(DR[s]), base[1] + i * int(DC[s])) for i in range(1, k + 1)]
-        m.path = deque(path)
-        m.goal, m.run_heading, m.mode = path[-1], back, "shift"
-        return None
+        return plan
 
     def _shift_length(self, m: Memory, base: tuple[int, int], side: int) -> int:
         """How many cells (up to ``w``) the robot can shift sideways from ``base``."""
@@ -230,6 +247,8 @@ class PsaCwaPolicy(ScriptedPolicy):
             path = quadtree.plan(cfree, cur, (target[0] - origin[0], target[1] - origin[1]))
             if path is None:
                 continue
+            if self.repush:
+                m.stack.push(seg)  # what this run leaves of it is found on a later pop
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             m.goal, m.run_heading, m.run_side = target, heading, seg.side
             m.mode = "transfer"
@@ -249,7 +268,7 @@ class PsaCwaPolicy(ScriptedPolicy):
                 return None
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             return None
-        m.mode, m.lane_start = "lane", (r, c)
+        m.mode, m.lane_start, m.first_lane = "lane", (r, c), True
         return None
 
     # -------------------------------------------------------------- CWA modes

@@ -3,7 +3,18 @@
 ``sweep("maze", seed=0)`` makes ``motiongym/Sweeper-v0`` on the maze, runs
 PSA + CWA from the seeded start until every reachable cell is swept, and
 returns the final ``info`` (coverage, travel, overlap, turns, ...) with the
-wall time and the coverage reached when PSA handed over to CWA.
+wall time, the coverage reached when PSA handed over to CWA and the travel
+split by what the robot was doing (``travel_by_mode``: lanes, shifts,
+transfers between runs, corner work).
+
+:func:`smartdfs_ratio` is the travel bound of the SmartDFS exploration
+strategy (Icking, Kamphans, Klein, Langetepe, "Exploring simple grid
+polygons", COCOON 2005): a simple grid polygon of ``C`` cells and ``E``
+boundary edges is explored, returning to the start, in at most
+``C + E/2 - 3`` steps. At robot scale a cell is a ``w x w`` block (blocks
+anchored at the start configuration, ``C`` and ``E`` from
+:func:`motiongym.envs.sweeper.world.smartdfs_bound`) and a step is ``w``
+cells of travel; the ratio is that travel over the lower bound area / w.
 """
 
 from __future__ import annotations
@@ -12,8 +23,10 @@ import time
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 
 from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.envs.sweeper import world
 
 POLICY_CLASSES = {
     "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
@@ -34,6 +47,25 @@ def make_policy(name: str, env: gym.Env, env_kwargs: dict[str, Any]) -> Scripted
     )
 
 
+#: policy modes grouped for the travel breakdown (anything else counts as "other")
+MODE_GROUPS = {
+    "lane": "lane",
+    "shift": "shift",
+    "pop": "transfer",
+    "transfer": "transfer",
+    "cwa_scan": "cwa",
+    "cwa_pop": "cwa",
+    "cwa_follow": "cwa",
+}
+
+
+def smartdfs_ratio(reachable: np.ndarray, w: int, start: tuple[int, int]) -> float:
+    """SmartDFS's bound ``w (C + E/2 - 3)`` over the lower bound ``area / w`` (see module doc)."""
+    c_count, edges, _ = world.smartdfs_bound(reachable, w, start)
+    area = float(np.count_nonzero(reachable))
+    return w * (c_count + edges / 2.0 - 3.0) / (area / w) if area else float("inf")
+
+
 def run_episode(
     env: gym.Env,
     policy: ScriptedPolicy,
@@ -41,24 +73,29 @@ def run_episode(
     options: dict | None = None,
     max_steps: int | None = None,
 ) -> dict[str, Any]:
-    """One episode; returns the last ``info`` plus ``wall_s``, ``psa_coverage``, ``memory``."""
+    """One episode; returns the last ``info`` plus ``wall_s``, ``psa_coverage``,
+    ``travel_by_mode`` (cells moved per :data:`MODE_GROUPS` group) and ``memory``."""
     obs, info = env.reset(seed=seed, options=options)
     memory = policy.new_memory()
     psa_coverage = None
     t0 = time.perf_counter()
     steps = 0
+    by_mode = dict.fromkeys(("lane", "shift", "transfer", "cwa", "other"), 0.0)
     while True:
         action = policy.act(obs, memory)
         mode = getattr(memory, "mode", "")
         if psa_coverage is None and mode.startswith(("cwa", "done")):
             psa_coverage = info["coverage"]
+        travel = info["travel"]
         obs, _, terminated, truncated, info = env.step(action)
+        by_mode[MODE_GROUPS.get(mode, "other")] += info["travel"] - travel
         steps += 1
         if terminated or truncated or (max_steps is not None and steps >= max_steps):
             break
     out = dict(info)
     out["wall_s"] = time.perf_counter() - t0
     out["psa_coverage"] = info["coverage"] if psa_coverage is None else psa_coverage
+    out["travel_by_mode"] = by_mode
     out["memory"] = memory
     return out
 
