@@ -6,9 +6,9 @@ MiniGrid's ``MiniGrid-Empty-16x16-v0``, and PPO on ``Reacher-v5`` for
 training. The issues' goals are checked here (never by timed tests):
 ``GOALS`` for environment throughput, ``PLANNERS`` for planning times.
 
-Memory: each ID runs in a fresh subprocess for ``memory_steps`` random steps;
-the resident set size is read after the first tenth and at the end, and the
-growth between them reported with the peak.
+Memory: each ID runs in a fresh subprocess (:mod:`motiongym.agents.memory_probe`)
+for a million random steps (20,000 with ``--quick``): the environment's own
+resident memory, its peak, and the growth from the first tenth to the end.
 """
 
 from __future__ import annotations
@@ -149,36 +149,17 @@ def planner_seconds(target: str, repeats: int) -> float:
     return float(np.median(times))
 
 
-def memory_probe(env_id: str, steps: int) -> dict[str, float]:
-    """Run in a fresh process: RSS (MiB) after a tenth of the steps, at the end, and peak."""
-    import resource
-
-    def rss_mib() -> float:
-        pages = int(Path("/proc/self/statm").read_text().split()[1])
-        return pages * resource.getpagesize() / 2**20
-
-    env = gym.make(env_id)
-    env.reset(seed=0)
-    env.action_space.seed(0)
-    actions = [env.action_space.sample() for _ in range(1024)]
-    early = rss_mib()
-    for step in range(steps):
-        _, _, terminated, truncated, _ = env.step(actions[step % len(actions)])
-        if terminated or truncated:
-            env.reset()
-        if step == steps // 10:
-            early = rss_mib()
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    return {"rss_early_mib": early, "rss_end_mib": rss_mib(), "peak_mib": peak}
-
-
 def memory_growth(env_id: str, steps: int) -> dict[str, float]:
-    code = (
-        "import json, motiongym; from motiongym.agents.bench import memory_probe; "
-        f"print(json.dumps(memory_probe({env_id!r}, {steps})))"
-    )
+    """Resident memory of ``env_id`` over ``steps`` random steps, in a fresh process.
+
+    See :mod:`motiongym.agents.memory_probe`; adds ``growth_mib``, the change
+    between the first tenth of the run and its end.
+    """
     result = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+        [sys.executable, "-m", "motiongym.agents.memory_probe", env_id, str(steps)],
+        capture_output=True,
+        text=True,
+        check=True,
     )
     probe = json.loads(result.stdout.strip().splitlines()[-1])
     probe["growth_mib"] = probe["rss_end_mib"] - probe["rss_early_mib"]
@@ -269,7 +250,7 @@ def markdown(results: dict[str, Any]) -> str:
         + ".",
         "",
         "| ID | steps/s | x CartPole | x Reacher | x MiniGrid | PPO steps/s (x Reacher PPO) "
-        "| goal | peak MiB / growth over run |",
+        "| goal | env MiB (peak) / growth over run |",
         "|---|---:|---:|---:|---:|---:|---|---|",
     ]
     for row in results["environments"]:
@@ -279,7 +260,8 @@ def markdown(results: dict[str, Any]) -> str:
             f"| {row['id']} | {row['steps_per_s']:,.0f} | {row['x CartPole-v1']:.2f} "
             f"| {row['x Reacher-v5']:.2f} | {row['x MiniGrid-Empty-16x16-v0']:.2f} "
             f"| {row['ppo_steps_per_s']:,.0f} ({row['x PPO Reacher-v5']:.2f}) | {goal} "
-            f"| {memory['peak_mib']:.0f} / {memory['growth_mib']:+.1f} over "
+            f"| {memory['env_mib']:.1f} ({memory['env_peak_mib']:.1f}) / "
+            f"{memory['growth_mib']:+.1f} over "
             f"{memory['steps']:,} steps |"
         )
     for row in results["environments"]:
