@@ -7,7 +7,7 @@ writes into ``out_dir`` (``sweeper.json`` and PNG figures):
    random starts and on procedurally generated maps (paper 4.1.1: full
    coverage "whatever the complexity"); travel against the lower bound
    (reachable area / W) and the SmartDFS bound ``W (C + E/2 - 3)``
-   (:func:`motiongym.baselines.sweeper.run.smartdfs_ratio`), and the travel
+   (:func:`motiongym.envs.sweeper.world.smartdfs_bound`), and the travel
    split into lanes, shifts, transfers between runs and corner work.
    SmartDFS's bound is for simple grid polygons and a tour back to the start
    (Icking et al. 2005); with H obstacles its authors' bound grows by
@@ -37,7 +37,7 @@ import gymnasium as gym
 import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
-from motiongym.baselines.sweeper.run import make_policy, run_episode, smartdfs_ratio
+from motiongym.baselines.sweeper.run import make_policy, run_episode
 from motiongym.envs.sweeper import generator, maps, world
 
 ENV_ID = "motiongym/Sweeper-v0"
@@ -67,7 +67,7 @@ def _bound(env: gym.Env) -> float:
     """SmartDFS ratio ``W (C + E/2 - 3) / (area / W)`` of the episode just run (blocks
     anchored at the robot's start)."""
     sc = env.unwrapped.scenario
-    return smartdfs_ratio(sc.reachable, W, sc.start)
+    return world.smartdfs_bound(sc.reachable, W, sc.start)[2]
 
 
 def _shares(runs: list[dict]) -> dict[str, float]:

@@ -7,14 +7,8 @@ wall time, the coverage reached when PSA handed over to CWA and the travel
 split by what the robot was doing (``travel_by_mode``: lanes, shifts,
 transfers between runs, corner work).
 
-:func:`smartdfs_ratio` is the travel bound of the SmartDFS exploration
-strategy (Icking, Kamphans, Klein, Langetepe, "Exploring simple grid
-polygons", COCOON 2005): a simple grid polygon of ``C`` cells and ``E``
-boundary edges is explored, returning to the start, in at most
-``C + E/2 - 3`` steps. At robot scale a cell is a ``w x w`` block (blocks
-anchored at the start configuration, ``C`` and ``E`` from
-:func:`motiongym.envs.sweeper.world.smartdfs_bound`) and a step is ``w``
-cells of travel; the ratio is that travel over the lower bound area / w.
+The travel goal is set by SmartDFS's bound,
+:func:`motiongym.envs.sweeper.world.smartdfs_bound`.
 """
 
 from __future__ import annotations
@@ -23,10 +17,8 @@ import time
 from typing import Any
 
 import gymnasium as gym
-import numpy as np
 
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.sweeper import world
 
 POLICY_CLASSES = {
     "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
@@ -57,13 +49,6 @@ MODE_GROUPS = {
     "cwa_pop": "cwa",
     "cwa_follow": "cwa",
 }
-
-
-def smartdfs_ratio(reachable: np.ndarray, w: int, start: tuple[int, int]) -> float:
-    """SmartDFS's bound ``w (C + E/2 - 3)`` over the lower bound ``area / w`` (see module doc)."""
-    c_count, edges, _ = world.smartdfs_bound(reachable, w, start)
-    area = float(np.count_nonzero(reachable))
-    return w * (c_count + edges / 2.0 - 3.0) / (area / w) if area else float("inf")
 
 
 def run_episode(

@@ -86,14 +86,19 @@ def entering_mask(dr: int, dc: int, w: int) -> np.ndarray:
 def smartdfs_bound(
     reachable: np.ndarray, w: int, anchor: tuple[int, int] = (0, 0)
 ) -> tuple[int, int, float]:
-    """SmartDFS's travel bound ``C + E/2`` on the map, at robot scale.
+    """SmartDFS's travel bound ``C + E/2 - 3`` on the map, at robot scale.
 
-    The map is cut into ``w x w`` blocks, one of them at ``anchor`` (the
-    robot's start configuration: the grid the robot itself would explore);
-    ``C`` counts blocks holding a reachable cell and ``E`` the block edges
-    between such a block and any other (boundary edges). Returns
-    ``(C, E, ratio)`` where ``ratio`` is the bound in cells, ``w (C + E/2)``,
-    divided by the lower bound ``area / w``.
+    SmartDFS (Icking, Kamphans, Klein, Langetepe, "Exploring simple grid
+    polygons", COCOON 2005) explores a simple grid polygon of ``C`` cells
+    and ``E`` boundary edges, returning to the start, in at most
+    ``C + E/2 - 3`` steps. The theorem is for polygons without holes and a
+    closed tour, so against a sweep that need not return it is a strict
+    yardstick. Here the map is cut into ``w x w`` blocks, one of them at
+    ``anchor`` (the robot's start configuration: the grid the robot itself
+    would explore); ``C`` counts blocks holding a reachable cell and ``E``
+    the block edges between such a block and any other. Returns
+    ``(C, E, ratio)``: the bound in cells, ``w (C + E/2 - 3)`` (a step is
+    ``w`` cells), over the lower bound ``area / w``.
     """
     top, left = (-anchor[0]) % w, (-anchor[1]) % w
     reachable = np.pad(reachable, ((top, 0), (left, 0)))
@@ -106,7 +111,7 @@ def smartdfs_bound(
     c_count = int(blocks.sum())
     edges = int((b[1:, :] != b[:-1, :]).sum() + (b[:, 1:] != b[:, :-1]).sum())
     area = float(reachable.sum())
-    ratio = w * (c_count + edges / 2.0) / (area / w) if area else float("inf")
+    ratio = w * (c_count + edges / 2.0 - 3.0) / (area / w) if area else float("inf")
     return c_count, edges, ratio
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
-from motiongym.baselines.sweeper.run import smartdfs_ratio, sweep
+from motiongym.baselines.sweeper.run import sweep
 from motiongym.envs.sweeper import world
 from motiongym.envs.sweeper.generator import empty_room
 
@@ -32,7 +32,7 @@ def _ratios(map_name: str, seeds: range) -> tuple[np.ndarray, np.ndarray]:
         env.reset(seed=seed)
         sc = env.unwrapped.scenario
         ours.append(info["travel_ratio"])
-        bound.append(smartdfs_ratio(sc.reachable, 3, sc.start))
+        bound.append(world.smartdfs_bound(sc.reachable, 3, sc.start)[2])
     return np.array(ours), np.array(bound)
 
 
@@ -40,14 +40,10 @@ def test_smartdfs_ratio_on_a_block_aligned_room() -> None:
     # a 12 x 12 free square, W = 3: 4 x 4 blocks, C = 16, E = 16 boundary edges
     reachable = np.zeros((14, 14), bool)
     reachable[1:13, 1:13] = True
-    c_count, edges, _ = world.smartdfs_bound(reachable, 3, (1, 1))
+    c_count, edges, ratio = world.smartdfs_bound(reachable, 3, (1, 1))
     assert (c_count, edges) == (16, 16)
     # C + E/2 - 3 = 21 steps of 3 cells = 63 cells, lower bound 144 / 3 = 48 cells
-    assert smartdfs_ratio(reachable, 3, (1, 1)) == pytest.approx(63 / 48)
-    # the same bound as the world's ``w (C + E/2)`` ratio, three steps tighter
-    assert smartdfs_ratio(reachable, 3, (1, 1)) == pytest.approx(
-        world.smartdfs_bound(reachable, 3, (1, 1))[2] - 3 * 3 / (144 / 3)
-    )
+    assert ratio == pytest.approx(63 / 48)
 
 
 def test_travel_by_mode_adds_up_to_the_travel() -> None:
@@ -119,7 +115,7 @@ def procedural() -> tuple[np.ndarray, np.ndarray]:
         assert info["is_success"], seed
         sc = env.unwrapped.scenario
         ours.append(info["travel_ratio"])
-        bound.append(smartdfs_ratio(sc.reachable, 3, sc.start))
+        bound.append(world.smartdfs_bound(sc.reachable, 3, sc.start)[2])
     return np.array(ours), np.array(bound)
 
 

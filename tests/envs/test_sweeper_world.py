@@ -61,7 +61,7 @@ def test_smartdfs_bound_empty_room() -> None:
     reach = np.ones((12, 18), bool)  # 12 x 18 floor: 4 x 6 blocks of 3 x 3
     c, e, ratio = world.smartdfs_bound(reach, 3)
     assert (c, e) == (24, 20)
-    assert ratio == pytest.approx(3 * (24 + 10) / (216 / 3))
+    assert ratio == pytest.approx(3 * (24 + 10 - 3) / (216 / 3))
 
 
 def test_bfs_distance_and_descend() -> None:
