@@ -1,9 +1,10 @@
 """Throughput of every world, its scripted policies and planners, and PPO on it.
 
 Machines are noisy, so every figure is printed beside a reference measured in
-the same run, as a ratio: Gymnasium's ``CartPole-v1`` and ``Reacher-v5``,
-MiniGrid's ``MiniGrid-Empty-16x16-v0``, and PPO on ``Reacher-v5`` for
-training. The issues' goals are checked here (never by timed tests):
+the same run, as a ratio (environments and their references are timed in
+alternating chunks, so that load drifting during the run affects both
+alike): Gymnasium's ``CartPole-v1`` and ``Reacher-v5``, MiniGrid's
+``MiniGrid-Empty-16x16-v0``, and PPO on ``Reacher-v5`` for training. The issues' goals are checked here (never by timed tests):
 ``GOALS`` for environment throughput, ``PLANNERS`` for planning times.
 
 Memory: each ID runs in a fresh subprocess (:mod:`motiongym.agents.memory_probe`)
@@ -88,6 +89,27 @@ def steps_per_second(env: gym.Env, seconds: float, seed: int = 0) -> float:
                 env.reset()
         steps += len(actions)
     return steps / (time.perf_counter() - start)
+
+
+def interleaved_steps_per_second(
+    envs: dict[str, gym.Env], seconds: float, rounds: int = 5
+) -> dict[str, float]:
+    """Steps per second of each env, measured in alternating chunks.
+
+    The machine's load drifts; timing an environment and its references in
+    turns, ``rounds`` times, exposes them to the same drift, so the ratios
+    between them are fair.
+    """
+    steps = dict.fromkeys(envs, 0.0)
+    elapsed = dict.fromkeys(envs, 0.0)
+    for _ in range(rounds):
+        for name, env in envs.items():
+            start = time.perf_counter()
+            rate = steps_per_second(env, seconds / rounds)
+            took = time.perf_counter() - start
+            steps[name] += rate * took
+            elapsed[name] += took
+    return {name: steps[name] / elapsed[name] for name in envs}
 
 
 def vector_steps_per_second(env: gym.vector.VectorEnv, seconds: float) -> float:
@@ -179,19 +201,17 @@ def bench(out_dir: Path, quick: bool = False, env_ids: list[str] | None = None) 
     seconds = 0.5 if quick else 3.0
     env_ids = list(env_ids or ENV_IDS)
     results: dict[str, Any] = {"machine": machine(), "quick": quick, "references": {}}
-    for reference in REFERENCES:
-        results["references"][reference] = steps_per_second(gym.make(reference), seconds)
+    references = {reference: gym.make(reference) for reference in REFERENCES}
+    results["references"].update(interleaved_steps_per_second(references, seconds))
     ppo_steps = 1024 if quick else 8192
     results["references"]["PPO Reacher-v5"] = ppo_steps_per_second("Reacher-v5", ppo_steps)
 
     rows = []
     for env_id in env_ids:
-        row: dict[str, Any] = {
-            "id": env_id,
-            "steps_per_s": steps_per_second(make_env(env_id), seconds),
-        }
+        rates = interleaved_steps_per_second({env_id: make_env(env_id), **references}, seconds)
+        row: dict[str, Any] = {"id": env_id, "steps_per_s": rates[env_id]}
         for reference in REFERENCES:
-            row[f"x {reference}"] = row["steps_per_s"] / results["references"][reference]
+            row[f"x {reference}"] = rates[env_id] / rates[reference]
         reference, goal = GOALS.get(env_id, (None, None))
         if reference:
             row["goal"] = f">= {goal}x {reference}"
@@ -245,7 +265,8 @@ def markdown(results: dict[str, Any]) -> str:
     """The environment table as Markdown (for the README)."""
     refs = results["references"]
     lines = [
-        f"Measured on: {results['machine']}. References in the same run: "
+        f"Measured on: {results['machine']}. References (timed in turns with each ID; "
+        "here the first measurement): "
         + ", ".join(f"{name} {rate:,.0f} steps/s" for name, rate in refs.items())
         + ".",
         "",
