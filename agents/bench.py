@@ -1,11 +1,13 @@
 """Throughput of every world, its scripted policies and planners, and PPO on it.
 
 Machines are noisy, so every figure is printed beside a reference measured in
-the same run, as a ratio (environments and their references are timed in
-alternating chunks, so that load drifting during the run affects both
-alike): Gymnasium's ``CartPole-v1`` and ``Reacher-v5``, MiniGrid's
-``MiniGrid-Empty-16x16-v0``, and PPO on ``Reacher-v5`` for training. The issues' goals are checked here (never by timed tests):
-``GOALS`` for environment throughput, ``PLANNERS`` for planning times.
+the same run, as a ratio; environments and their references are timed in
+alternating chunks, so that load drifting during the run affects both alike.
+The references: Gymnasium's ``CartPole-v1`` and ``Reacher-v5``, MiniGrid's
+``MiniGrid-Empty-16x16-v0``, and PPO on ``Reacher-v5`` for training. The
+issues' goals are checked here (never by timed tests): ``GOALS`` for
+environment throughput, ``VECTOR_GOALS`` for the natively vectorised worlds,
+``PLANNERS`` for planning times.
 
 Memory: each ID runs in a fresh subprocess (:mod:`motiongym.agents.memory_probe`)
 for a million random steps (20,000 with ``--quick``): the environment's own
