@@ -40,9 +40,9 @@ def test_hand_computed_cases():
 
 def test_random_segments_match_dense_sampling():
     rng = np.random.default_rng(0)
-    pts = rng.uniform(-1, 1, size=(300, 4, 3))
+    pts = rng.uniform(-1, 1, size=(120, 4, 3))
     d, on_p, on_q = closest_points_between_segments(pts[:, 0], pts[:, 1], pts[:, 2], pts[:, 3])
-    for i in range(300):
+    for i in range(len(pts)):
         sampled = _sampled_segment_distance(*pts[i])
         assert d[i] <= sampled + 1e-9
         assert d[i] == pytest.approx(sampled, abs=5e-3)
