@@ -168,20 +168,20 @@ class DualArmCellEnv(gym.Env):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         a1, a2 = self._parse(action)
         w = self.world
-        done2_before = w.finished[1]
-        w.advance(a1, a2)
-        if not done2_before:
+        if w.p2 < w.n2:  # robot 2 not done before this step
             self._wait2 += (1.0 - a2) * DT
-        collided = w.distance <= self.safety_margin
+        w.advance(a1, a2)
         d = w.distance
+        collided = d <= self.safety_margin
+        weights = self.weights
         terms = {
-            "time": -self.weights["time"] * DT,
-            "collision": -self.weights["collision"] if collided else 0.0,
-            "clearance": -self.weights["clearance"] * max(0.0, 1.0 - d / self.clearance_distance),
+            "time": -weights["time"] * DT,
+            "collision": -weights["collision"] if collided else 0.0,
+            "clearance": -weights["clearance"] * max(0.0, 1.0 - d / self.clearance_distance),
         }
         reward = terms["time"] + terms["collision"] + terms["clearance"]
-        terminated = collided or all(w.finished)
-        return w.observation(), float(reward), bool(terminated), False, self._info(collided, terms)
+        terminated = collided or (w.p1 >= w.n1 and w.p2 >= w.n2)
+        return w.observation(), float(reward), terminated, False, self._info(collided, terms)
 
     def render(self) -> np.ndarray | None:
         if self.render_mode != "rgb_array":
@@ -197,22 +197,21 @@ class DualArmCellEnv(gym.Env):
         a = checked_box_action(
             action, self.action_space.shape, f"advance per arm, control={self.control!r}"
         )
-        values = [min(max(float(v), 0.0), 1.0) for v in a]
+        values = [min(max(v, 0.0), 1.0) for v in a.tolist()]
         if self.control == "both":
             return values[0], values[1]
         return 1.0, values[0]
 
     def _info(self, collided: bool, terms: dict[str, float]) -> dict[str, Any]:
         w = self.world
-        done = all(w.finished)
         info = {
-            "is_success": bool(done and not collided),
+            "is_success": not collided and w.p1 >= w.n1 and w.p2 >= w.n2,
             "cost": 1.0 if collided else 0.0,
-            "collision": bool(collided),
+            "collision": collided,
             "distance": w.distance,
-            "makespan": w.elapsed,
-            "progress_1": float(w.progress[0]),
-            "progress_2": float(w.progress[1]),
+            "makespan": w.steps * DT,
+            "progress_1": w.p1,
+            "progress_2": w.p2,
             "robot_2_wait": self._wait2,
         }
         for k, v in terms.items():

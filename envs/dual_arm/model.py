@@ -340,7 +340,13 @@ class MujocoCell:
         mujoco.mj_kinematics(self.model, self.data)
 
     def distances(self, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
-        self.set_joints(q1, q2)
+        self.data.qpos[:6] = q1
+        self.data.qpos[6:] = q2
+        return self.current_distances()
+
+    def current_distances(self) -> np.ndarray:
+        """``d_ij`` (5, 5) at the joints already in ``data.qpos``."""
+        mujoco.mj_kinematics(self.model, self.data)
         mujoco.mj_collision(self.model, self.data)
         n = self.data.ncon
         con = self.data.contact

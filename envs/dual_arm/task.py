@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.dual_arm import model
+from motiongym.envs.dual_arm import model, sweep
 
 DT = 0.02  # s, controller sample time (paper)
 N_VIAS = 4
@@ -98,8 +98,13 @@ class Trajectory:
         return self.vias[seg] + s * (self.vias[seg + 1] - self.vias[seg])
 
     def samples(self) -> np.ndarray:
-        """(N + 1, 6) joint angles at ``k * DT``."""
-        return self.at_time(np.arange(self.n_samples + 1) * DT)
+        """(N + 1, 6) joint angles at ``k * DT``; computed once, read-only."""
+        cached = self.__dict__.get("_samples")
+        if cached is None:
+            cached = self.at_time(np.arange(self.n_samples + 1) * DT)
+            cached.flags.writeable = False
+            object.__setattr__(self, "_samples", cached)
+        return cached
 
     def wrist_length(self, oversample: int = 8) -> tuple[np.ndarray, np.ndarray]:
         """Wrist-centre arc length on a fine time grid: ``(times, lengths)``."""
@@ -141,13 +146,7 @@ def tool_tip_z(frames: np.ndarray) -> np.ndarray:
     return fr[..., 2, 3] + fr[..., 2, 2] * model.LINKS[5][1][2]
 
 
-def _arm_geometry(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Tip heights (N + 1,) and capsule end points (N + 1, 5, 3) x 2 at the samples."""
-    frames = model.body_frames(traj.samples(), model.base_transform(traj.robot))
-    return (tool_tip_z(frames), *model.segments_from_frames(frames))
-
-
-def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, tuple]:
+def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, sweep.Sweep]:
     while True:
         lo, hi = VIA_BOXES[..., 0], VIA_BOXES[..., 1]
         vias = rng.uniform(lo, hi)  # (K, 6)
@@ -156,33 +155,24 @@ def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, tuple
         dur = minimum * rng.uniform(*SLOWNESS, size=N_VIAS - 1)
         dur = np.ceil(np.maximum(dur, 0.2) / DT) * DT
         traj = Trajectory(vias, dur, robot)
-        tip, a, b = _arm_geometry(traj)
-        if tip.min() >= MIN_TOOL_Z:
-            return traj, (a, b)
+        swept = sweep.Sweep.of(traj.samples(), robot)
+        if swept.tip_z.min() >= MIN_TOOL_Z:
+            return traj, swept
 
 
-def _check_pair(seg1: tuple, seg2: tuple, margin: float) -> tuple[bool, bool]:
-    """(collides when both start together, one after the other is collision free);
-    the second is only computed when the first holds.
+def _check_pair(swept1: sweep.Sweep, swept2: sweep.Sweep, margin: float) -> tuple[bool, bool]:
+    """(collides when both start together, one after the other is collision free).
 
     One after the other: robot 1's whole path clears robot 2's start and robot
-    2's whole path clears robot 1's end.
+    2's whole path clears robot 1's end. Both from one exact test over the
+    instants of both schedules.
     """
-    (a1, b1), (a2, b2) = seg1, seg2
-    n1, n2 = len(a1) - 1, len(a2) - 1
-    k = np.arange(max(n1, n2) + 1)
-    i1, i2 = np.minimum(k, n1), np.minimum(k, n2)
-    if not model.segments_any_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin):
-        return False, True  # sequential clearance not needed: rejected anyway
-    return True, _sequential_ok(seg1, seg2, margin)
-
-
-def _sequential_ok(seg1: tuple, seg2: tuple, margin: float) -> bool:
-    (a1, b1), (a2, b2) = seg1, seg2
-    n1, n2 = len(a1) - 1, len(a2) - 1
-    i1 = np.concatenate([np.arange(n1 + 1), np.full(n2 + 1, n1)])
-    i2 = np.concatenate([np.zeros(n1 + 1, int), np.arange(n2 + 1)])
-    return not model.segments_any_collide(a1[i1], b1[i1], a2[i2], b2[i2], margin)
+    n1, n2 = swept1.n_samples, swept2.n_samples
+    (t1, t2), (s1, s2) = sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)
+    hit = sweep.colliding_instants(
+        swept1, np.concatenate([t1, s1]), swept2, np.concatenate([t2, s2]), margin
+    )
+    return bool(hit[: len(t1)].any()), not hit[len(t1) :].any()
 
 
 def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
@@ -194,8 +184,9 @@ def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
 
 def sequential_clear(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> bool:
     """Robot 1's path clears robot 2's start and robot 2's path clears robot 1's end."""
-    seg = [_arm_geometry(t)[1:] for t in (traj1, traj2)]
-    return _sequential_ok(seg[0], seg[1], margin)
+    s1, s2 = (sweep.Sweep.of(t.samples(), t.robot) for t in (traj1, traj2))
+    rows1, rows2 = sweep.sequential_rows(traj1.n_samples, traj2.n_samples)
+    return not sweep.colliding_instants(s1, rows1, s2, rows2, margin).any()
 
 
 def sample_pair(

@@ -77,64 +77,99 @@ def tasks_from_observation(obs: np.ndarray) -> tuple[Trajectory, Trajectory]:
 
 
 class DualArmWorld:
-    """Both arms on their trajectories, stepped by advances; no reward, no episode logic."""
+    """Both arms on their trajectories, stepped by advances; no reward, no episode logic.
+
+    The joints live in the MuJoCo data (``cell.data.qpos``: robot 1, then 2);
+    progress is kept as Python floats (``p1``, ``p2`` of ``n1``, ``n2``).
+    """
 
     def __init__(self) -> None:
-        self.cell = model.MujocoCell()
         self._renderer: mujoco.Renderer | None = None
         self.tasks: tuple[Trajectory, Trajectory] | None = None
+        self._attach(model.MujocoCell())
+
+    def _attach(self, cell: model.MujocoCell) -> None:
+        self.cell = cell
+        qpos = cell.data.qpos
+        self._qpos = (qpos[:6], qpos[6:])  # views into the MuJoCo data
 
     def load(self, traj1: Trajectory, traj2: Trajectory) -> None:
         self.tasks = (traj1, traj2)
         self.samples = (traj1.samples(), traj2.samples())  # (N_r + 1, 6) each
-        self.n = np.array([traj1.n_samples, traj2.n_samples], dtype=float)
-        self.progress = np.zeros(2)
+        self._deltas = tuple(np.diff(q, axis=0) for q in self.samples)  # (N_r, 6) each
+        self.n1, self.n2 = float(traj1.n_samples), float(traj2.n_samples)
+        self.p1 = self.p2 = 0.0
         self.steps = 0
-        self._task_obs = np.concatenate([traj1.compact(), traj2.compact()]).astype(np.float32)
+        self._obs = np.empty(OBS_SIZE, dtype=np.float32)  # template: the tasks part is fixed
+        self._obs[OBS["task1"].start :] = np.concatenate([traj1.compact(), traj2.compact()])
         self._update()
 
+    @property
+    def n(self) -> np.ndarray:
+        """Last sample index of each arm, (2,)."""
+        return np.array([self.n1, self.n2])
+
+    @property
+    def progress(self) -> np.ndarray:
+        """Progress of each arm in samples, (2,)."""
+        return np.array([self.p1, self.p2])
+
+    @property
+    def q(self) -> tuple[np.ndarray, np.ndarray]:
+        """Joint angles of robot 1 and robot 2, (6,) each (copies)."""
+        return self._qpos[0].copy(), self._qpos[1].copy()
+
     def config(self, robot: int) -> np.ndarray:
-        p = self.progress[robot]
-        k = int(p)
+        """Joint angles (6,) of ``robot`` at its progress (linear between samples)."""
+        out = np.empty(6)
+        self._config(robot, (self.p1, self.p2)[robot], out)
+        return out
+
+    def _config(self, robot: int, p: float, out: np.ndarray) -> None:
         q = self.samples[robot]
+        k = int(p)
         if k >= len(q) - 1:
-            return q[-1]
+            out[:] = q[-1]
+            return
         f = p - k
-        return q[k] if f == 0.0 else q[k] + f * (q[k + 1] - q[k])
+        if f == 0.0:
+            out[:] = q[k]
+        else:
+            np.add(q[k], f * self._deltas[robot][k], out=out)
 
     def _update(self) -> None:
-        self.q = (self.config(0), self.config(1))
-        self.distances = self.cell.distances(self.q[0], self.q[1])  # (5, 5)
+        self._config(0, self.p1, self._qpos[0])
+        self._config(1, self.p2, self._qpos[1])
+        self.distances = self.cell.current_distances()  # (5, 5)
         self.distance = float(self.distances.min())
 
     def advance(self, a1: float, a2: float) -> None:
-        p, n = self.progress, self.n
-        p[0] = min(p[0] + a1, n[0])
-        p[1] = min(p[1] + a2, n[1])
+        self.p1 = min(self.p1 + a1, self.n1)
+        self.p2 = min(self.p2 + a2, self.n2)
         self.steps += 1
         self._update()
 
     @property
     def finished(self) -> tuple[bool, bool]:
-        return bool(self.progress[0] >= self.n[0]), bool(self.progress[1] >= self.n[1])
+        return self.p1 >= self.n1, self.p2 >= self.n2
 
     @property
     def elapsed(self) -> float:
         return self.steps * DT
 
     def observation(self) -> np.ndarray:
-        obs = np.empty(OBS_SIZE, dtype=np.float32)
-        obs[0:6], obs[6:12] = self.q
-        obs[12:14] = self.progress / self.n
-        obs[14] = self.elapsed
+        obs = self._obs.copy()
+        obs[0:12] = self.cell.data.qpos
+        obs[12] = self.p1 / self.n1
+        obs[13] = self.p2 / self.n2
+        obs[14] = self.steps * DT
         obs[15:40] = self.distances.ravel()  # within [-1, 5] m by the cell's size
-        obs[40:] = self._task_obs
         return obs
 
     def render(self, width: int = 640, height: int = 480) -> np.ndarray:
         if self._renderer is None:
             self._renderer = mujoco.Renderer(self.cell.model, height, width)
-        self.cell.set_joints(*self.q)
+        mujoco.mj_kinematics(self.cell.model, self.cell.data)
         mujoco.mj_camlight(self.cell.model, self.cell.data)  # cameras and lights
         self._renderer.update_scene(self.cell.data, camera="overview")
         return self._renderer.render().copy()
@@ -146,10 +181,13 @@ class DualArmWorld:
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
+        state["_qpos"] = None
         state["cell"] = None
         state["_renderer"] = None
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
-        self.cell = model.MujocoCell()
+        self._attach(model.MujocoCell())
+        if self.tasks is not None:
+            self._update()

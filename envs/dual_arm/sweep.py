@@ -1,0 +1,227 @@
+"""Capsules swept along whole sampled trajectories, and where two sweeps collide.
+
+The task sampler's hot path (:func:`motiongym.envs.dual_arm.task.sample_pair`
+runs it on every reset, often more than once): the 5 checked capsules of an
+arm at every 20 ms sample of its trajectory, and the exact test "is
+``d(R1, R2) <= margin``" (paper eqs. 1-2) at many pairs of instants. Same
+numbers as :func:`.model.link_segments` and :func:`.model.segment_pair_distances`
+(to rounding), in far fewer NumPy operations: arrays are laid out with the
+samples last, so that every operation runs over all samples at once.
+
+Kinematics (:func:`sweep_points`): the DH chain of :mod:`.model`, ``F_k =
+B_k L_k`` with the body frame ``B_k = F_{k-1} Rz(q_k)`` and ``L_k = Tz(d_k)
+Tx(a_k) Rx(alpha_k)``, kept as the origin ``p`` and the axes ``x``, ``y``,
+``z`` (each (3, n)), with the pair ``x + i y`` as one complex array so that
+``Rz(q)`` is one complex product: ``(x + i y) e^{-iq} = (c x + s y) + i (c y
+- s x)``. ``L_k`` then only shifts the origin and, through ``Rx(alpha)``, mixes
+``y`` and ``z`` (PUMA: alpha in {0, +-pi/2}; coefficients within 1e-12 of 0
+or +-1 are taken exactly). A capsule end point, given in ``B_k``
+(``model.LINKS``), is taken in ``B_k`` or, as ``L_k^{-1} e``, in ``F_k``,
+whichever has fewer non-zero coordinates: for the PUMA one or none, so each
+end point costs at most a product and a sum over all samples.
+
+Collision (:func:`colliding_instants`), exact: bounding spheres about the
+capsule centres, radius ``h + r`` (half length plus radius), clear a pair
+when ``|c_i - c_j| - (h_i + r_i + h_j + r_j) > margin`` (tested 1e-9 m
+outside, so conservative); every other pair gets the exact segment distance
+(:func:`motiongym.envs.geometry.closest_points_between_segments`), all in
+one call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from motiongym.envs.dual_arm import model
+from motiongym.envs.geometry import closest_points_between_segments
+
+_SLACK = 1e-9  # m: the broad phase keeps pairs up to this much beyond the margin
+
+
+def _snap(v: float) -> float:
+    """``v``, with values within 1e-12 of 0, 1 or -1 made exact."""
+    for exact in (0.0, 1.0, -1.0):
+        if abs(v - exact) < 1e-12:
+            return exact
+    return v
+
+
+# Per joint: (d, a, cos alpha, sin alpha).
+_CHAIN = tuple(
+    (float(d), float(a), _snap(math.cos(alpha)), _snap(math.sin(alpha))) for d, a, alpha in model.DH
+)
+
+
+def _end_point_plan() -> dict[int, list[tuple[int, int, str, tuple[float, float, float]]]]:
+    """Per joint index k: the end points of body k + 1 as (capsule, end, frame, coords)."""
+    plan: dict[int, list] = {}
+    for i, body in enumerate(model.CHECKED):
+        inv = np.linalg.inv(model._LINK[body - 1])
+        for end in range(2):
+            in_b = tuple(float(v) for v in model.LINKS[body - 1][end])
+            in_f = tuple(_snap(float(v)) for v in (inv @ np.array([*in_b, 1.0]))[:3])
+            nonzero_b, nonzero_f = sum(v != 0 for v in in_b), sum(v != 0 for v in in_f)
+            frame, coords = ("B", in_b) if nonzero_b <= nonzero_f else ("F", in_f)
+            plan.setdefault(body - 1, []).append((i, end, frame, coords))
+    return plan
+
+
+_PLAN = _end_point_plan()
+_BASES = tuple(model.base_transform(r) for r in range(2))
+_RSUM = (model.RADII[:, None] + model.RADII[None, :]).ravel()  # (25,)
+_REACH = model._REACH.ravel()  # (25,)
+
+
+def _terms(coefs: tuple[float, ...]) -> tuple[tuple[int, float], ...]:
+    """The non-zero ``(index, coefficient)`` of ``coefs``."""
+    return tuple((i, c) for i, c in enumerate(coefs) if c != 0.0)
+
+
+def _sum(terms: tuple[tuple[int, float], ...], arrays: tuple) -> np.ndarray:
+    """``sum c * arrays[i]`` over ``terms`` (unit coefficients without a product)."""
+    out = None
+    for i, c in terms:
+        term = arrays[i] if c == 1.0 else -arrays[i] if c == -1.0 else c * arrays[i]
+        out = term if out is None else out + term
+    return out
+
+
+# Per joint k: (d, a, rx, y' terms over (y, z), z' terms over (y, z), end points) with
+# end points (end, capsule, in F_k?, terms over (x, y, z)) of body k + 1.
+_STEPS = tuple(
+    (
+        d,
+        a,
+        not (sa == 0.0 and ca == 1.0),
+        _terms((ca, sa)),
+        _terms((-sa, ca)),
+        tuple((end, i, frame == "F", _terms(coords)) for i, end, frame, coords in _PLAN.get(k, ())),
+    )
+    for k, (d, a, ca, sa) in enumerate(_CHAIN)
+)
+
+
+def sweep_points(q: np.ndarray, robot: int) -> np.ndarray:
+    """Capsule end points of robot 0 or 1 at joint samples ``q`` (n, 6), rad.
+
+    Returns:
+        (2, 5, 3, n), m, world frame: [end a/b, capsule (order ``model.CHECKED``),
+        xyz, sample].
+    """
+    qt = np.asarray(q, float).T  # (6, n)
+    n = qt.shape[1]
+    rot = np.empty((6, n), complex)  # cos q - i sin q
+    np.cos(qt, out=rot.real)
+    np.sin(-qt, out=rot.imag)
+    base = _BASES[robot]
+    w = (base[:3, 0] + 1j * base[:3, 1])[:, None]  # x + i y, (3, 1) then (3, n)
+    z, p = base[:3, 2:3], base[:3, 3:4]
+    out = np.empty((2, 5, 3, n))
+    for k, (d, a, rx, y_terms, z_terms, ends) in enumerate(_STEPS):
+        b = w * rot[k]  # axes of B_k: x + i y; z is z_{k-1}
+        p_body, axes_body = p, (b.real, b.imag, z)
+        if a:
+            p = p + a * b.real
+        if d:
+            p = p + d * z
+        if rx:  # Rx(alpha): y' = ca y + sa z, z' = ca z - sa y
+            yz = (b.imag, z)
+            w = np.empty((3, n), complex)
+            w.real = b.real
+            w.imag = _sum(y_terms, yz)
+            z = _sum(z_terms, yz)
+        else:
+            w = b
+        for end, i, in_f, terms in ends:
+            origin, axes = (p, (w.real, w.imag, z)) if in_f else (p_body, axes_body)
+            if terms:
+                np.add(origin, _sum(terms, axes), out=out[end, i])
+            else:
+                out[end, i] = origin
+    return out
+
+
+def capsule_points(q: np.ndarray, robot: int) -> tuple[np.ndarray, np.ndarray]:
+    """End points ``(a, b)`` of the 5 checked capsules, each (..., 5, 3), m, world
+    frame, for joint angles ``q`` (..., 6): as ``model.link_segments``."""
+    q = np.asarray(q, float)
+    pts = sweep_points(q.reshape(-1, 6), robot)  # (2, 5, 3, n)
+    a, b = (np.moveaxis(pts[e], -1, 0).reshape(q.shape[:-1] + (5, 3)) for e in range(2))
+    return a, b
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """One arm's capsules at its samples ``0..N``.
+
+    Attributes:
+        points: (2, 5, 3, N + 1) end points, as :func:`sweep_points`, m.
+        centres: (5, 3, N + 1) capsule centres, m.
+    """
+
+    points: np.ndarray
+    centres: np.ndarray
+
+    @staticmethod
+    def of(q: np.ndarray, robot: int) -> Sweep:
+        """The sweep of joint samples ``q`` (N + 1, 6) of robot 0 or 1."""
+        pts = sweep_points(q, robot)
+        return Sweep(pts, (pts[0] + pts[1]) * 0.5)
+
+    @property
+    def n_samples(self) -> int:
+        """N: index of the last sample."""
+        return self.points.shape[-1] - 1
+
+    @property
+    def tip_z(self) -> np.ndarray:
+        """Height of the gripper tip (the gripper capsule's far end), (N + 1,) m."""
+        return self.points[1, 4, 2]
+
+    def segments(self) -> tuple[np.ndarray, np.ndarray]:
+        """End points ``(a, b)`` as (N + 1, 5, 3) each (``model.link_segments`` layout)."""
+        return np.moveaxis(self.points[0], -1, 0), np.moveaxis(self.points[1], -1, 0)
+
+
+def colliding_instants(
+    s1: Sweep, rows1: np.ndarray, s2: Sweep, rows2: np.ndarray, margin: float = 0.0
+) -> np.ndarray:
+    """Exactly where ``d(R1, R2) <= margin``: robot 1 at its sample ``rows1[k]``,
+    robot 2 at ``rows2[k]`` (integer arrays of one length m). Returns (m,) bool."""
+    c1 = np.take(s1.centres, rows1, axis=2)  # (5, 3, m), C-contiguous (unlike [..., rows])
+    c2 = np.take(s2.centres, rows2, axis=2)
+    diff = c1[:, None] - c2[None]  # (5, 5, 3, m)
+    d2 = np.einsum("ijcm,ijcm->ijm", diff, diff)  # (5, 5, m) squared centre distances
+    near = _REACH + margin + _SLACK  # (25,)
+    near2 = np.where(near >= 0.0, near * near, -1.0)
+    m = len(rows1)
+    cand = np.flatnonzero(d2.reshape(25, m) <= near2[:, None])  # pair * m + k
+    out = np.zeros(m, dtype=bool)
+    if len(cand) == 0:
+        return out
+    pair, k = np.divmod(cand, m)
+    i, j = np.divmod(pair, 5)
+    p1, p2 = s1.points, s2.points
+    r1, r2 = rows1[k], rows2[k]
+    dist, _, _ = closest_points_between_segments(
+        p1[0, i, :, r1], p1[1, i, :, r1], p2[0, j, :, r2], p2[1, j, :, r2]
+    )  # (c,)
+    out[k[dist - _RSUM[pair] <= margin]] = True
+    return out
+
+
+def together_rows(n1: int, n2: int) -> tuple[np.ndarray, np.ndarray]:
+    """Both start together: instant ``k`` pairs samples ``min(k, N_r)``, (max(N1, N2) + 1,)."""
+    k = np.arange(max(n1, n2) + 1)
+    return np.minimum(k, n1), np.minimum(k, n2)
+
+
+def sequential_rows(n1: int, n2: int) -> tuple[np.ndarray, np.ndarray]:
+    """One after the other: robot 1's path at robot 2's start, then robot 2's path at
+    robot 1's end, (N1 + N2 + 2,)."""
+    rows1 = np.concatenate([np.arange(n1 + 1), np.full(n2 + 1, n1)])
+    rows2 = np.concatenate([np.zeros(n1 + 1, np.int64), np.arange(n2 + 1)])
+    return rows1, rows2
