@@ -104,9 +104,13 @@ _STEPS = tuple(
 )
 
 
-def sweep_points(q: np.ndarray, robot: int) -> np.ndarray:
-    """Capsule end points of robot 0 or 1 at joint samples ``q`` (n, 6), rad.
+def sweep_points(q: np.ndarray, robot: int | np.ndarray) -> np.ndarray:
+    """Capsule end points at joint samples ``q`` (n, 6), rad.
 
+    Args:
+        q: joint angles (n, 6), rad.
+        robot: 0 or 1 (base frame, paper eq. 3), or one per sample (n,) to do
+            samples of both arms in one batch.
     Returns:
         (2, 5, 3, n), m, world frame: [end a/b, capsule (order ``model.CHECKED``),
         xyz, sample].
@@ -116,9 +120,12 @@ def sweep_points(q: np.ndarray, robot: int) -> np.ndarray:
     rot = np.empty((6, n), complex)  # cos q - i sin q
     np.cos(qt, out=rot.real)
     np.sin(-qt, out=rot.imag)
-    base = _BASES[robot]
-    w = (base[:3, 0] + 1j * base[:3, 1])[:, None]  # x + i y, (3, 1) then (3, n)
-    z, p = base[:3, 2:3], base[:3, 3:4]
+    if isinstance(robot, (int, np.integer)):
+        base = _BASES[robot][:3, :, None]  # (3, 4, 1)
+    else:
+        base = np.stack(_BASES, axis=-1)[:3, :, robot]  # (3, 4, n)
+    w = base[:, 0] + 1j * base[:, 1]  # x + i y, (3, 1 or n) then (3, n)
+    z, p = base[:, 2], base[:, 3]
     out = np.empty((2, 5, 3, n))
     for k, (d, a, rx, y_terms, z_terms, ends) in enumerate(_STEPS):
         b = w * rot[k]  # axes of B_k: x + i y; z is z_{k-1}
@@ -170,6 +177,19 @@ class Sweep:
         """The sweep of joint samples ``q`` (N + 1, 6) of robot 0 or 1."""
         pts = sweep_points(q, robot)
         return Sweep(pts, (pts[0] + pts[1]) * 0.5)
+
+    @staticmethod
+    def of_pair(q1: np.ndarray, q2: np.ndarray) -> tuple[Sweep, Sweep]:
+        """``(Sweep.of(q1, 0), Sweep.of(q2, 1))`` in one batch."""
+        n1 = len(q1)
+        robot = np.zeros(n1 + len(q2), np.int64)
+        robot[n1:] = 1
+        pts = sweep_points(np.concatenate([q1, q2]), robot)
+        centres = (pts[0] + pts[1]) * 0.5
+        return (
+            Sweep(pts[..., :n1], centres[..., :n1]),
+            Sweep(pts[..., n1:], centres[..., n1:]),
+        )
 
     @property
     def n_samples(self) -> int:

@@ -55,7 +55,7 @@ SLOWNESS = (1.0, 1.6)  # range of the factor on each segment's minimum duration
 
 def quintic(tau: np.ndarray) -> np.ndarray:
     """Rest-to-rest time law ``s(tau)``, tau in [0, 1]."""
-    tau = np.clip(tau, 0.0, 1.0)
+    tau = np.minimum(np.maximum(tau, 0.0), 1.0)  # np.clip, without its overhead
     return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau * tau)
 
 
@@ -91,11 +91,12 @@ class Trajectory:
     def at_time(self, t: np.ndarray) -> np.ndarray:
         """Joint angles at times ``t`` (...,) s -> (..., 6); clamped to [0, T]."""
         t = np.asarray(t, float)
-        bounds = np.concatenate([[0.0], np.cumsum(self.durations)])  # (K,)
-        seg = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, N_VIAS - 2)
+        bounds = np.zeros(N_VIAS)  # (K,)
+        np.cumsum(self.durations, out=bounds[1:])
+        seg = np.minimum(np.maximum(np.searchsorted(bounds, t, side="right") - 1, 0), N_VIAS - 2)
         tau = (t - bounds[seg]) / self.durations[seg]
         s = quintic(tau)[..., None]
-        return self.vias[seg] + s * (self.vias[seg + 1] - self.vias[seg])
+        return self.vias[seg] + s * np.diff(self.vias, axis=0)[seg]
 
     def samples(self) -> np.ndarray:
         """(N + 1, 6) joint angles at ``k * DT``; computed once, read-only."""
@@ -146,18 +147,42 @@ def tool_tip_z(frames: np.ndarray) -> np.ndarray:
     return fr[..., 2, 3] + fr[..., 2, 2] * model.LINKS[5][1][2]
 
 
+def _draw_arm(rng: np.random.Generator, robot: int) -> Trajectory:
+    """One draw of an arm's vias and segment durations (tip height not checked)."""
+    lo, hi = VIA_BOXES[..., 0], VIA_BOXES[..., 1]
+    vias = rng.uniform(lo, hi)  # (K, 6)
+    dq = np.abs(np.diff(vias, axis=0))  # (K-1, 6)
+    minimum = PEAK * np.max(dq / V_MAX, axis=1)
+    dur = minimum * rng.uniform(*SLOWNESS, size=N_VIAS - 1)
+    dur = np.ceil(np.maximum(dur, 0.2) / DT) * DT
+    return Trajectory(vias, dur, robot)
+
+
 def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, sweep.Sweep]:
+    """Draws until the gripper tip stays above ``MIN_TOOL_Z``."""
     while True:
-        lo, hi = VIA_BOXES[..., 0], VIA_BOXES[..., 1]
-        vias = rng.uniform(lo, hi)  # (K, 6)
-        dq = np.abs(np.diff(vias, axis=0))  # (K-1, 6)
-        minimum = PEAK * np.max(dq / V_MAX, axis=1)
-        dur = minimum * rng.uniform(*SLOWNESS, size=N_VIAS - 1)
-        dur = np.ceil(np.maximum(dur, 0.2) / DT) * DT
-        traj = Trajectory(vias, dur, robot)
+        traj = _draw_arm(rng, robot)
         swept = sweep.Sweep.of(traj.samples(), robot)
         if swept.tip_z.min() >= MIN_TOOL_Z:
             return traj, swept
+
+
+def _sample_arms(rng: np.random.Generator) -> tuple[tuple, tuple]:
+    """``(_sample_arm(rng, 0), _sample_arm(rng, 1))``: the same draws in the same
+    order, with both arms' geometry computed in one batch. Robot 2 is drawn
+    before robot 1's tip is checked; if robot 1 is redrawn (rare), the
+    generator is put back to just after robot 1's draw, as if robot 2's draw
+    had not happened."""
+    traj1 = _draw_arm(rng, 0)
+    after1 = rng.bit_generator.state
+    traj2 = _draw_arm(rng, 1)
+    swept1, swept2 = sweep.Sweep.of_pair(traj1.samples(), traj2.samples())
+    if swept1.tip_z.min() < MIN_TOOL_Z:
+        rng.bit_generator.state = after1
+        return _sample_arm(rng, 0), _sample_arm(rng, 1)
+    if swept2.tip_z.min() < MIN_TOOL_Z:
+        return (traj1, swept1), _sample_arm(rng, 1)
+    return (traj1, swept1), (traj2, swept2)
 
 
 def _check_pair(swept1: sweep.Sweep, swept2: sweep.Sweep, margin: float) -> tuple[bool, bool]:
@@ -198,7 +223,7 @@ def sample_pair(
     if mode == "paper":
         return paper_case()
     for _ in range(max_tries):
-        (t1, s1), (t2, s2) = _sample_arm(rng, 0), _sample_arm(rng, 1)
+        (t1, s1), (t2, s2) = _sample_arms(rng)
         if mode == "any":
             return t1, t2
         collides, sequential_ok = _check_pair(s1, s2, margin)

@@ -105,3 +105,18 @@ def test_samples_are_computed_once_and_read_only():
     q = t1.samples()
     assert t1.samples() is q and not q.flags.writeable
     np.testing.assert_array_equal(q, t1.at_time(np.arange(t1.n_samples + 1) * task.DT))
+
+
+@pytest.mark.parametrize("min_tool_z", [0.5, 0.6])
+def test_batched_arms_draw_as_one_after_the_other(monkeypatch, min_tool_z):
+    # A high floor makes tip rejections of either arm common: the batched draw
+    # must still give the arms, and leave the generator, as drawing them in turn.
+    monkeypatch.setattr(task, "MIN_TOOL_Z", min_tool_z)
+    for seed in range(15):
+        rng_a, rng_b = np.random.default_rng(seed), np.random.default_rng(seed)
+        batched = task._sample_arms(rng_a)
+        in_turn = (task._sample_arm(rng_b, 0), task._sample_arm(rng_b, 1))
+        for (traj, swept), (traj_ref, swept_ref) in zip(batched, in_turn, strict=True):
+            np.testing.assert_array_equal(traj.compact(), traj_ref.compact())
+            np.testing.assert_allclose(swept.points, swept_ref.points, atol=1e-12)
+        assert rng_a.random() == rng_b.random()
