@@ -206,30 +206,77 @@ class Sweep:
         return np.moveaxis(self.points[0], -1, 0), np.moveaxis(self.points[1], -1, 0)
 
 
-def colliding_instants(
-    s1: Sweep, rows1: np.ndarray, s2: Sweep, rows2: np.ndarray, margin: float = 0.0
-) -> np.ndarray:
-    """Exactly where ``d(R1, R2) <= margin``: robot 1 at its sample ``rows1[k]``,
-    robot 2 at ``rows2[k]`` (integer arrays of one length m). Returns (m,) bool."""
+def _centre_distances(s1: Sweep, rows1: np.ndarray, s2: Sweep, rows2: np.ndarray) -> np.ndarray:
+    """Squared centre distances (25, m) of all capsule pairs at instants ``(rows1, rows2)``."""
     c1 = np.take(s1.centres, rows1, axis=2)  # (5, 3, m), C-contiguous (unlike [..., rows])
     c2 = np.take(s2.centres, rows2, axis=2)
     diff = c1[:, None] - c2[None]  # (5, 5, 3, m)
-    d2 = np.einsum("ijcm,ijcm->ijm", diff, diff)  # (5, 5, m) squared centre distances
-    near = _REACH + margin + _SLACK  # (25,)
-    near2 = np.where(near >= 0.0, near * near, -1.0)
-    m = len(rows1)
-    cand = np.flatnonzero(d2.reshape(25, m) <= near2[:, None])  # pair * m + k
-    out = np.zeros(m, dtype=bool)
-    if len(cand) == 0:
-        return out
-    pair, k = np.divmod(cand, m)
+    return np.einsum("ijcm,ijcm->ijm", diff, diff).reshape(25, len(rows1))
+
+
+def _squared(bound: np.ndarray) -> np.ndarray:
+    """``bound**2`` where ``bound >= 0``, else -1 (no squared distance is that small)."""
+    return np.where(bound >= 0.0, bound * bound, -1.0)
+
+
+def _exact_hits(
+    s1: Sweep, rows1: np.ndarray, s2: Sweep, rows2: np.ndarray, cand: np.ndarray, margin: float
+) -> np.ndarray:
+    """Instants k (with repeats) of the candidates ``cand`` (flat ``pair * m + k``)
+    whose exact distance is ``<= margin``."""
+    pair, k = np.divmod(cand, len(rows1))
     i, j = np.divmod(pair, 5)
     p1, p2 = s1.points, s2.points
     r1, r2 = rows1[k], rows2[k]
     dist, _, _ = closest_points_between_segments(
         p1[0, i, :, r1], p1[1, i, :, r1], p2[0, j, :, r2], p2[1, j, :, r2]
     )  # (c,)
-    out[k[dist - _RSUM[pair] <= margin]] = True
+    return k[dist - _RSUM[pair] <= margin]
+
+
+def colliding_instants(
+    s1: Sweep, rows1: np.ndarray, s2: Sweep, rows2: np.ndarray, margin: float = 0.0
+) -> np.ndarray:
+    """Exactly where ``d(R1, R2) <= margin``: robot 1 at its sample ``rows1[k]``,
+    robot 2 at ``rows2[k]`` (integer arrays of one length m). Returns (m,) bool."""
+    d2 = _centre_distances(s1, rows1, s2, rows2)
+    cand = np.flatnonzero(d2 <= _squared(_REACH + margin + _SLACK)[:, None])
+    out = np.zeros(len(rows1), dtype=bool)
+    if len(cand):
+        out[_exact_hits(s1, rows1, s2, rows2, cand, margin)] = True
+    return out
+
+
+def schedules_collide(
+    s1: Sweep, s2: Sweep, schedules: list[tuple[np.ndarray, np.ndarray]], margin: float = 0.0
+) -> list[bool]:
+    """For each schedule ``(rows1, rows2)``: does ``d(R1, R2) <= margin`` at any of
+    its instants? Exact; one broad phase and one exact call for all schedules.
+
+    A schedule in which some pair of capsule centres is within ``r_i + r_j +
+    margin`` (1e-9 m inside, so that rounding never decides) surely collides:
+    the centres are points of the segments. Only the other schedules' pairs
+    go to the exact distance.
+    """
+    rows1 = np.concatenate([r1 for r1, _ in schedules])
+    rows2 = np.concatenate([r2 for _, r2 in schedules])
+    d2 = _centre_distances(s1, rows1, s2, rows2)
+    near = d2 <= _squared(_REACH + margin + _SLACK)[:, None]  # (25, m)
+    sure = np.any(d2 <= _squared(_RSUM + margin - _SLACK)[:, None], axis=0)  # (m,)
+    ends = np.cumsum([len(r1) for r1, _ in schedules])
+    starts = np.concatenate([[0], ends[:-1]])
+    out = []
+    for lo, hi in zip(starts, ends, strict=True):
+        decided = bool(sure[lo:hi].any())
+        if decided:
+            near[:, lo:hi] = False
+        out.append(decided)
+    cand = np.flatnonzero(near)
+    if len(cand):
+        hit_at = np.zeros(len(rows1), dtype=bool)
+        hit_at[_exact_hits(s1, rows1, s2, rows2, cand, margin)] = True
+        for n, (lo, hi) in enumerate(zip(starts, ends, strict=True)):
+            out[n] = out[n] or bool(hit_at[lo:hi].any())
     return out
 
 

@@ -190,14 +190,13 @@ def _check_pair(swept1: sweep.Sweep, swept2: sweep.Sweep, margin: float) -> tupl
 
     One after the other: robot 1's whole path clears robot 2's start and robot
     2's whole path clears robot 1's end. Both from one exact test over the
-    instants of both schedules.
+    instants of both schedules (:func:`.sweep.schedules_collide`).
     """
     n1, n2 = swept1.n_samples, swept2.n_samples
-    (t1, t2), (s1, s2) = sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)
-    hit = sweep.colliding_instants(
-        swept1, np.concatenate([t1, s1]), swept2, np.concatenate([t2, s2]), margin
+    together, sequential = sweep.schedules_collide(
+        swept1, swept2, [sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)], margin
     )
-    return bool(hit[: len(t1)].any()), not hit[len(t1) :].any()
+    return together, not sequential
 
 
 def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:

@@ -63,12 +63,14 @@ def test_colliding_instants_is_exact():
     for _ in range(25):
         (t1, s1), (t2, s2) = task._sample_arm(rng, 0), task._sample_arm(rng, 1)
         n1, n2 = t1.n_samples, t2.n_samples
-        for rows1, rows2 in (sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)):
-            for margin in (-0.02, 0.0, 0.05, 0.3):
+        schedules = [sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)]
+        for margin in (-0.02, 0.0, 0.05, 0.3):
+            exact = [_exact_hits(s1, r1, s2, r2, margin) for r1, r2 in schedules]
+            for (rows1, rows2), hits in zip(schedules, exact, strict=True):
                 np.testing.assert_array_equal(
-                    sweep.colliding_instants(s1, rows1, s2, rows2, margin),
-                    _exact_hits(s1, rows1, s2, rows2, margin),
+                    sweep.colliding_instants(s1, rows1, s2, rows2, margin), hits
                 )
+            assert sweep.schedules_collide(s1, s2, schedules, margin) == [h.any() for h in exact]
 
 
 def test_colliding_instants_at_the_margin():
@@ -83,6 +85,9 @@ def test_colliding_instants_at_the_margin():
     hits = sweep.colliding_instants(s1, rows1, s2, rows2, float(d[k]))
     assert hits[k] and hits.sum() == np.sum(d <= d[k])
     assert not sweep.colliding_instants(s1, rows1, s2, rows2, float(d[k]) - 1e-7).any()
+    schedule = [(rows1, rows2)]
+    assert sweep.schedules_collide(s1, s2, schedule, float(d[k])) == [True]
+    assert sweep.schedules_collide(s1, s2, schedule, float(d[k]) - 1e-7) == [False]
 
 
 def test_pair_checks_match_their_definitions():
