@@ -16,7 +16,7 @@ import yaml
 
 from motiongym.agents.environments import check_env_id, make_env, short_name
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import EVALUATION_SEED
+from motiongym.agents.evaluate import EVALUATION_SEED, Evaluation
 from motiongym.baselines.registry import UnknownPolicyError
 from motiongym.envs import ENV_IDS
 
@@ -24,7 +24,7 @@ DEFAULT_EPISODES = 10
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
-    """``["dof=5", "map=maze"]`` -> ``{"dof": 5, "map": "maze"}`` (values read as YAML)."""
+    """``["dof=5", "map_name=maze"]`` -> ``{"dof": 5, "map_name": "maze"}`` (values as YAML)."""
     kwargs = {}
     for pair in pairs:
         key, sep, value = pair.partition("=")
@@ -34,7 +34,8 @@ def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
     return kwargs
 
 
-def _evaluations(env_id, policies, args):
+def _evaluations(env_id: str, policies: list[str], args: argparse.Namespace) -> list[Evaluation]:
+    """Every policy on the same seeded episodes of ``env_id``."""
     from motiongym.agents.evaluate import evaluate
     from motiongym.agents.predictors import load_predictor, policy_label
 
