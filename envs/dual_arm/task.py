@@ -23,7 +23,11 @@ when both start together, and running them one after the other is collision
 free (robot 1's whole path clears robot 2's start, robot 2's whole path clears
 robot 1's end), so a finite start delay always exists; ``"paper"``: the fixed
 paper case (:func:`paper_case`), colliding undelayed over an interval like the
-paper's 0.76-1.16 s.
+paper's 0.76-1.16 s. Every test is exact at every 20 ms sample; the geometry
+of both arms' samples and the collision tests run in few NumPy operations
+(:mod:`.sweep`), since this runs on every reset. The draws are those of
+drawing robot 1 until accepted, then robot 2 (:func:`_sample_arms`), so a
+seed's tasks do not depend on how the geometry is computed.
 """
 
 from __future__ import annotations
