@@ -194,25 +194,6 @@ def segments_collide(
     return np.asarray(bool(hit.any()))
 
 
-def segments_any_collide(
-    a1: np.ndarray, b1: np.ndarray, a2: np.ndarray, b2: np.ndarray, margin: float = 0.0
-) -> bool:
-    """``any(segments_collide(...))`` for end points (m, 5, 3), with early exit:
-    candidate pairs are checked exactly in order of their bounding-sphere gap."""
-    c1, c2 = (a1 + b1) / 2, (a2 + b2) / 2
-    diff = c1[:, :, None, :] - c2[:, None, :, :]  # (m, 5, 5, 3)
-    gap = (np.sqrt(np.sum(diff * diff, axis=-1)) - _REACH).ravel()
-    near = np.flatnonzero(gap <= margin)
-    near = near[np.argsort(gap[near], kind="stable")]
-    for start in range(0, len(near), 128):
-        m, rest = np.divmod(near[start : start + 128], 25)
-        i, j = np.divmod(rest, 5)
-        dist, _, _ = closest_points_between_segments(a1[m, i], b1[m, i], a2[m, j], b2[m, j])
-        if np.any(dist - RADII[i] - RADII[j] <= margin):
-            return True
-    return False
-
-
 def pair_distances(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     """The 25 link-pair distances ``d_ij`` (paper eq. 1), batched.
 
