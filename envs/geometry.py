@@ -8,7 +8,7 @@ segment). A capsule of radius r1 and one of radius r2 are apart by
 All functions broadcast over leading axes: points are ``(..., dim)`` arrays
 (dim 2 or 3). Degenerate segments (zero length) are handled as points.
 The segment-segment routine follows Ericson, *Real-Time Collision Detection*
-(2005), section 5.1.9, with the branches written as ``np.where``.
+(2005), section 5.1.9, with its branches folded into a few ``np.where``.
 """
 
 from __future__ import annotations
@@ -16,6 +16,16 @@ from __future__ import annotations
 import numpy as np
 
 _EPS = 1e-12
+
+
+def _dot(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Row-wise dot product over the last axis."""
+    return np.add.reduce(u * v, axis=-1)
+
+
+def _unit(x: np.ndarray) -> np.ndarray:
+    """``x`` clamped to [0, 1] (cheaper than ``np.clip`` on small arrays)."""
+    return np.minimum(np.maximum(x, 0.0), 1.0)
 
 
 def closest_point_on_segment(
@@ -40,39 +50,32 @@ def closest_points_between_segments(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closest points of segments ``p0p1`` and ``q0q1``.
 
+    Ericson's clamped solution, with the degenerate cases folded into it
+    (hot paths call this on a handful of segments, where NumPy's per-call
+    overhead dominates, so it is kept to few operations): the infinite lines'
+    parameter ``s`` (for parallel lines, the point of ``p`` nearest ``q0``),
+    ``t`` from ``s``, and where ``t`` must be clamped, ``s`` again from the
+    clamped ``t``. A zero-length segment has ``d = 0``, so its terms vanish
+    and the same formulas give its closest points.
+
     Returns:
         ``(distance, on_p, on_q)``: shapes ``(...)``, ``(..., dim)``, ``(..., dim)``.
     """
     p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
     q0, q1 = np.asarray(q0, float), np.asarray(q1, float)
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a = np.sum(d1 * d1, axis=-1)
-    e = np.sum(d2 * d2, axis=-1)
-    f = np.sum(d2 * r, axis=-1)
-    c = np.sum(d1 * r, axis=-1)
-    b = np.sum(d1 * d2, axis=-1)
+    a = np.maximum(_dot(d1, d1), _EPS)
+    e = np.maximum(_dot(d2, d2), _EPS)
+    b = _dot(d1, d2)
+    c = _dot(d1, r)
+    f = _dot(d2, r)
     denom = a * e - b * b
-    p_is_point = a <= _EPS
-    q_is_point = e <= _EPS
-    safe_a = np.maximum(a, _EPS)
-    safe_e = np.maximum(e, _EPS)
-    # General case: s from the infinite lines, clamped; parallel lines take s = 0.
-    s = np.where(
-        denom > _EPS * np.maximum(a * e, _EPS),
-        (b * f - c * e) / np.where(denom > 0, denom, 1.0),
-        0.0,
-    )
-    s = np.clip(s, 0.0, 1.0)
-    t = (b * s + f) / safe_e
-    # t outside [0, 1]: clamp it and recompute s for the clamped t.
-    s = np.where(t < 0.0, np.clip(-c / safe_a, 0.0, 1.0), s)
-    s = np.where(t > 1.0, np.clip((b - c) / safe_a, 0.0, 1.0), s)
-    t = np.clip(t, 0.0, 1.0)
-    # Degenerate segments.
-    s = np.where(p_is_point, 0.0, s)
-    t = np.where(p_is_point, np.clip(f / safe_e, 0.0, 1.0), t)
-    s = np.where(q_is_point & ~p_is_point, np.clip(-c / safe_a, 0.0, 1.0), s)
-    t = np.where(q_is_point, 0.0, t)
+    parallel = denom <= _EPS * a * e
+    s = _unit(np.where(parallel, -c * e, b * f - c * e) / np.where(parallel, a * e, denom))
+    t = (b * s + f) / e
+    clamped = _unit(t)
+    s = np.where(t == clamped, s, _unit((b * clamped - c) / a))
     on_p = p0 + s[..., None] * d1
-    on_q = q0 + t[..., None] * d2
-    return np.linalg.norm(on_p - on_q, axis=-1), on_p, on_q
+    on_q = q0 + clamped[..., None] * d2
+    diff = on_p - on_q
+    return np.sqrt(_dot(diff, diff)), on_p, on_q
