@@ -36,6 +36,7 @@ import numpy as np
 
 from motiongym.envs.dual_arm import model
 from motiongym.envs.dual_arm.task import DT, N_VIAS, Trajectory
+from motiongym.envs.rendering import OwnsRenderer
 
 _TASK = N_VIAS * 6 + N_VIAS - 1
 OBS: dict[str, slice] = {
@@ -76,7 +77,7 @@ def tasks_from_observation(obs: np.ndarray) -> tuple[Trajectory, Trajectory]:
     return out[0], out[1]
 
 
-class DualArmWorld:
+class DualArmWorld(OwnsRenderer):
     """Both arms on their trajectories, stepped by advances; no reward, no episode logic.
 
     The joints live in the MuJoCo data (``cell.data.qpos``: robot 1, then 2);
@@ -174,16 +175,10 @@ class DualArmWorld:
         self._renderer.update_scene(self.cell.data, camera="overview")
         return self._renderer.render().copy()
 
-    def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-
     def __getstate__(self) -> dict[str, Any]:
-        state = self.__dict__.copy()
+        state = super().__getstate__()
         state["_qpos"] = None
         state["cell"] = None
-        state["_renderer"] = None
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:

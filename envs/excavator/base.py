@@ -43,6 +43,7 @@ from motiongym.envs.excavator.kinematics import arm_points
 from motiongym.envs.excavator.obstacles import Pipe, Truck, pipe_clearance, truck_clearance
 from motiongym.envs.excavator.soil import Terrain, speed_fraction
 from motiongym.envs.excavator.task import GRID_CELL, GRID_ORIGIN, GRID_SHAPE, Scene
+from motiongym.envs.rendering import OwnsRenderer
 
 POUR_NZ = -0.3  # opening normal z below which soil pours
 POUR_TIME = 1.0  # s to empty a full bucket
@@ -68,7 +69,7 @@ def profile_table(L0: float, d2: float) -> np.ndarray:
     return i * GRID_SHAPE[1] + j
 
 
-class ExcavatorBase(gym.Env):
+class ExcavatorBase(OwnsRenderer, gym.Env):
     """Shared machinery; see :class:`ExcavatorReachEnv` and :class:`ExcavatorEnv`."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
@@ -373,13 +374,3 @@ class ExcavatorBase(gym.Env):
 
             self._renderer = SceneRenderer(self.m, self.render_size)
         return self._renderer.render(self)
-
-    def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-
-    def __getstate__(self) -> dict:
-        state = self.__dict__.copy()
-        state["_renderer"] = None
-        return state

@@ -18,11 +18,12 @@ from motiongym.envs.harvest_arm.task import (
     sample_scene,
     scene_from_obstacles,
 )
+from motiongym.envs.rendering import OwnsRenderer
 
 _RESET_OPTIONS = ("fruit", "obstacles", "q")
 
 
-class HarvestArmEnv(gym.Env):
+class HarvestArmEnv(OwnsRenderer, gym.Env):
     """Bring a redundant arm's gripper to a fruit while its links keep clear.
 
     The arm of Ryu et al. (fruit-harvesting redundant robot) among immature
@@ -352,13 +353,3 @@ class HarvestArmEnv(gym.Env):
             mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, 0.004, p0, p1)
             scene.ngeom += 1
         return self._renderer.render()
-
-    def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = self.__dict__.copy()
-        state["_renderer"] = None
-        return state
