@@ -53,7 +53,8 @@ RUN_SETTINGS: dict[str, Any] = {
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native")
-ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
+# Activation names accepted in policy_kwargs -> their torch.nn class names.
+ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU"}
 # Constructor arguments the run itself provides.
 _PROVIDED = {
     "self",

@@ -36,7 +36,12 @@ from stable_baselines3.common.vec_env import (
     VecNormalize,
 )
 
-from motiongym.agents.config import algorithm_kwargs, default_config_path, load_config
+from motiongym.agents.config import (
+    ACTIVATIONS,
+    algorithm_kwargs,
+    default_config_path,
+    load_config,
+)
 from motiongym.agents.environments import check_env_id, importable_id, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.predictors import MODEL_FILE, NORMALIZATION_FILE, algorithm_classes
@@ -49,13 +54,7 @@ def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
     """The block's ``policy_kwargs`` with the activation's name made a class."""
     kwargs = dict(config["policy_kwargs"])
     if "activation_fn" in kwargs:
-        names = {
-            "tanh": torch.nn.Tanh,
-            "relu": torch.nn.ReLU,
-            "elu": torch.nn.ELU,
-            "leaky_relu": torch.nn.LeakyReLU,
-        }
-        kwargs["activation_fn"] = names[kwargs["activation_fn"]]
+        kwargs["activation_fn"] = getattr(torch.nn, ACTIVATIONS[kwargs["activation_fn"]])
     return kwargs
 
 

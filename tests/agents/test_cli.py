@@ -54,6 +54,13 @@ def test_config_errors_name_the_key(capsys, tmp_path):
     malformed = tmp_path / "malformed.yml"
     malformed.write_text("ppo:\n  n_steps: [3\n")
     assert "malformed YAML" in _error(capsys, ["train", SWEEPER, "--config", str(malformed)])
+    bad_activation = tmp_path / "activation.yml"
+    bad_activation.write_text(
+        "ppo:\n  n_timesteps: 10\n  policy: MultiInputPolicy\n"
+        "  policy_kwargs: {activation_fn: swish}\n"
+    )
+    err = _error(capsys, ["train", SWEEPER, "--config", str(bad_activation)])
+    assert "'swish'" in err and "leaky_relu" in err
     missing = tmp_path / "missing.yml"
     assert "no configuration file" in _error(capsys, ["train", SWEEPER, "--config", str(missing)])
     no_block = tmp_path / "sac_only.yml"
