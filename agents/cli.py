@@ -114,7 +114,7 @@ def cmd_ship(args: argparse.Namespace) -> None:
     from motiongym.agents.pretrained import ship
     from motiongym.agents.report import console
 
-    console.print(f"shipped to {ship(args.run_dir, n_episodes=args.episodes)}")
+    console.print(f"shipped to {ship(args.run_dirs, n_episodes=args.episodes)}")
 
 
 def cmd_reproduce(args: argparse.Namespace) -> None:
@@ -197,8 +197,12 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     train.set_defaults(handler=cmd_train)
 
-    ship = commands.add_parser("ship", help="copy a training run into agents/pretrained/")
-    ship.add_argument("run_dir", type=Path, help="a run folder written by motiongym train")
+    ship = commands.add_parser(
+        "ship", help="evaluate the seeds' runs of one ID and algorithm, ship the best"
+    )
+    ship.add_argument(
+        "run_dirs", type=Path, nargs="+", help="run folders written by motiongym train"
+    )
     ship.add_argument("--episodes", type=int, default=20, help="held-out evaluation episodes")
     ship.set_defaults(handler=cmd_ship)
 

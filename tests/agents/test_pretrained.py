@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 
+import numpy as np
 import pytest
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import evaluate
+from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
 from motiongym.agents.predictors import load_predictor
 from motiongym.agents.pretrained import pretrained_models, ship, verify_manifest
 from motiongym.agents.train import train
@@ -42,14 +44,18 @@ def shipped_folder(tmp_path_factory):
     root = tmp_path_factory.mktemp("ship")
     config = root / "tiny.yml"
     config.write_text(TINY_CONFIG)
-    run_dir = train(
-        "motiongym/ExcavatorReach-v0",
-        "ppo",
-        config_path=config,
-        out_root=root / "runs",
-        progress=False,
-    )
-    return ship(run_dir, n_episodes=1, root=root / "pretrained")
+    run_dirs = [
+        train(
+            "motiongym/ExcavatorReach-v0",
+            "ppo",
+            config_path=config,
+            seed=seed,
+            out_root=root / "runs",
+            progress=False,
+        )
+        for seed in (0, 1)
+    ]
+    return ship(run_dirs, n_episodes=2, root=root / "pretrained")
 
 
 def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folder, tmp_path):
@@ -59,6 +65,7 @@ def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folde
         "config.yml",
         "command.txt",
         "metrics.json",
+        "learning_curves.csv",
         "manifest.json",
     ):
         assert (shipped_folder / name).is_file(), name
@@ -72,3 +79,23 @@ def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folde
     (tampered / "config.yml").unlink()
     with pytest.raises(UsageError, match="missing"):
         verify_manifest(tampered)
+
+
+def test_ship_reports_every_seed_and_pools_their_episodes(shipped_folder):
+    metrics = json.loads((shipped_folder / "metrics.json").read_text())
+    assert [run["training_seed"] for run in metrics["runs"]] == [0, 1]
+    assert metrics["held_out_seeds"] == [EVALUATION_SEED, EVALUATION_SEED + 1]
+    assert metrics["shipped_run"] in {run["run"] for run in metrics["runs"]}
+    returns = [episode["return"] for run in metrics["runs"] for episode in run["episodes"]]
+    assert metrics["pooled"]["return"]["mean"] == pytest.approx(np.mean(returns))
+    best = max(metrics["runs"], key=lambda run: run["summary"]["return"]["mean"])
+    assert metrics["shipped_run"] == best["run"]  # no success in 64 steps: ranked by return
+
+
+def test_ship_refuses_runs_of_different_ids(shipped_folder, tmp_path):
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "config.yml").write_text("env_id: motiongym/Sweeper-v0\nalgo: ppo\nseed: 0\n")
+    runs = shipped_folder.parent.parent.parent / "runs" / "ExcavatorReach-v0"
+    with pytest.raises(UsageError, match="one ID and algorithm"):
+        ship([next(runs.iterdir()), other], n_episodes=1, root=tmp_path / "pretrained")
