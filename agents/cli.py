@@ -1,4 +1,4 @@
-"""The ``motiongym`` command: list, evaluate, compare, train, ship, reproduce, bench.
+"""The ``motiongym`` command: list, evaluate, compare, train, ship, benchmarks, reproduce, bench.
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
 malformed YAML file, a model built for another space) ends in one line on
@@ -117,6 +117,13 @@ def cmd_ship(args: argparse.Namespace) -> None:
     console.print(f"shipped to {ship(args.run_dirs, n_episodes=args.episodes)}")
 
 
+def cmd_benchmarks(args: argparse.Namespace) -> None:
+    from motiongym.agents.benchmarks import write_benchmarks
+    from motiongym.agents.report import console
+
+    console.print(f"wrote {write_benchmarks(args.out, n_episodes=args.episodes)}")
+
+
 def cmd_reproduce(args: argparse.Namespace) -> None:
     from motiongym.agents.reproduce import reproduce
 
@@ -205,6 +212,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     ship.add_argument("--episodes", type=int, default=20, help="held-out evaluation episodes")
     ship.set_defaults(handler=cmd_ship)
+
+    benchmarks = commands.add_parser(
+        "benchmarks", help="regenerate BENCHMARKS.md: scripted vs learned on every ID"
+    )
+    benchmarks.add_argument("--episodes", type=int, default=20, help="held-out episodes")
+    benchmarks.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
+    benchmarks.set_defaults(handler=cmd_benchmarks)
 
     reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")
     reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))

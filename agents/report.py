@@ -43,7 +43,8 @@ def comparison_rows(evaluations: list[Evaluation]) -> list[list[str]]:
 
 
 def _comparison_title(evaluations: list[Evaluation]) -> str:
-    n = len(evaluations[0].episodes)
+    counts = sorted({len(evaluation.episodes) for evaluation in evaluations})
+    n = " or ".join(str(count) for count in counts)
     return f"{evaluations[0].env_id}: mean ± 95% interval over {n} episodes per policy"
 
 

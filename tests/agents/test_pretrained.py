@@ -13,7 +13,6 @@ from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
 from motiongym.agents.predictors import load_predictor
 from motiongym.agents.pretrained import pretrained_models, ship, verify_manifest
-from motiongym.agents.train import train
 from motiongym.envs import ENV_IDS
 
 SHIPPED = [(env_id, name) for env_id in ENV_IDS for name in pretrained_models(env_id)]
@@ -26,36 +25,6 @@ def test_shipped_model_verifies_loads_and_runs_an_episode(env_id, name):
     predictor = load_predictor(name, env_id, env)
     evaluation = evaluate(env, predictor, [123], env_id, name, progress=False)
     assert evaluation.episodes[0]["length"] > 0
-
-
-TINY_CONFIG = """
-ppo:
-  n_envs: 1
-  n_timesteps: 64
-  policy: MlpPolicy
-  n_steps: 64
-  batch_size: 32
-  normalize: true
-"""
-
-
-@pytest.fixture(scope="module")
-def shipped_folder(tmp_path_factory):
-    root = tmp_path_factory.mktemp("ship")
-    config = root / "tiny.yml"
-    config.write_text(TINY_CONFIG)
-    run_dirs = [
-        train(
-            "motiongym/ExcavatorReach-v0",
-            "ppo",
-            config_path=config,
-            seed=seed,
-            out_root=root / "runs",
-            progress=False,
-        )
-        for seed in (0, 1)
-    ]
-    return ship(run_dirs, n_episodes=2, root=root / "pretrained")
 
 
 def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folder, tmp_path):
@@ -79,6 +48,12 @@ def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folde
     (tampered / "config.yml").unlink()
     with pytest.raises(UsageError, match="missing"):
         verify_manifest(tampered)
+
+
+def test_ship_keeps_every_seed_learning_curve(shipped_folder):
+    rows = (shipped_folder / "learning_curves.csv").read_text().splitlines()
+    assert rows[0] == "training_seed,timesteps,mean_return,success_rate"
+    assert {row.split(",")[0] for row in rows[1:]} == {"0", "1"}
 
 
 def test_ship_reports_every_seed_and_pools_their_episodes(shipped_folder):

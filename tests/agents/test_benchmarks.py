@@ -1,0 +1,40 @@
+"""BENCHMARKS.md generation: scripted and pooled learned columns, figures, kept prose."""
+
+from __future__ import annotations
+
+import pytest
+
+from motiongym.agents import benchmarks
+
+ENV_ID = "motiongym/ExcavatorReach-v0"
+
+
+@pytest.fixture
+def one_shipped_id(monkeypatch, shipped_folder):
+    monkeypatch.setattr(benchmarks, "ENV_IDS", [ENV_ID])
+    monkeypatch.setattr(benchmarks, "pretrained_models", lambda env_id: {"ppo": shipped_folder})
+
+
+def test_pooled_evaluation_holds_every_seed_episode(shipped_folder):
+    evaluation, metrics = benchmarks.pooled_evaluation(shipped_folder)
+    assert evaluation.policy == "ppo (2 seeds)"
+    assert len(evaluation.episodes) == 2 * len(metrics["held_out_seeds"])
+
+
+def test_benchmarks_rewrites_only_the_generated_part(one_shipped_id, tmp_path):
+    path = tmp_path / "BENCHMARKS.md"
+    path.write_text(
+        f"# Benchmarks\n\nreading above\n\n{benchmarks.BEGIN}\nstale\n{benchmarks.END}\n"
+        "\nreading below\n"
+    )
+    benchmarks.write_benchmarks(path, n_episodes=2)
+    text = path.read_text()
+    assert "stale" not in text
+    assert text.index("reading above") < text.index(benchmarks.BEGIN)
+    assert text.index(benchmarks.END) < text.index("reading below")
+    generated = text.split(benchmarks.BEGIN)[1].split(benchmarks.END)[0]
+    header = next(line for line in generated.splitlines() if line.startswith("| measure"))
+    assert "newton-raphson-reach" in header and "ppo (2 seeds)" in header
+    assert "over 2 or 4 episodes per policy" in generated
+    assert (tmp_path / "docs" / "benchmarks" / "ExcavatorReach-v0.png").is_file()
+    assert "](docs/benchmarks/ExcavatorReach-v0.png)" in generated
