@@ -60,7 +60,10 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
     Reward, the sum of the terms (weights are keyword arguments of the same
     name): ``progress`` * decrease of the gripper-fruit distance (m);
     ``- clearance`` * max(0, 1 - d_min / safety_distance); ``- collision`` on
-    contact (d_min <= 0); ``- effort`` * mean(action^2); ``success`` on arrival.
+    contact (d_min <= 0); ``- effort`` * mean(action^2); ``success`` on arrival;
+    ``- distance`` * gripper-fruit distance (m) every step, 0 in the registered
+    IDs: a dense shaping that training configurations switch on (the progress
+    term telescopes, so a policy parked 0.5 m short loses only 5 in all).
 
     Termination: the gripper within ``success_tolerance`` of the fruit centre,
     or a collision (if ``terminate_on_collision``). Truncation: the
@@ -107,6 +110,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         collision: float = 10.0,
         effort: float = 0.01,
         success: float = 10.0,
+        distance: float = 0.0,
         render_mode: str | None = None,
         width: int = 480,
         height: int = 360,
@@ -130,6 +134,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "collision": collision,
             "effort": effort,
             "success": success,
+            "distance": distance,
         }
         self.render_mode, self.width, self.height = render_mode, width, height
 
@@ -267,6 +272,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "collision": -w["collision"] * float(collided),
             "effort": -w["effort"] * float(np.dot(a, a)) / len(a),
             "success": w["success"] * float(arrived),
+            "distance": -w["distance"] * d_fruit,
         }
         self._d_fruit = d_fruit
         if self.render_mode is not None:
