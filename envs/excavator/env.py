@@ -178,7 +178,12 @@ class ExcavatorEnv(ExcavatorBase):
     change of the bucket fill (m3; a potential, it sums to zero over a
     completed cycle); ``spill`` = -spill * soil spilled (m3);
     ``clearance`` = -clearance on a step with cost; ``contact`` = -contact
-    on contact; ``time`` = -time per step; ``success`` = +success on success.
+    on contact; ``time`` = -time per step; ``success`` = +success on success;
+    ``approach`` = -approach * |tip - subgoal| (m) every step, 0 in the
+    registered ID: a dense shaping for training (configs) that draws the
+    bucket into the middle of the zone at the marked depth while it holds
+    less than the soil still owed to the truck, and 1 m over the truck bed's
+    centre after (:meth:`subgoal`).
     Success: at least ``success_volume`` m3 in the truck and the bucket empty
     (below 2 % of its capacity) - the cycle is over. Extra ``info``:
     ``dig_fill`` (m3, the largest bucket fill so far: the fill at the end of
@@ -195,7 +200,16 @@ class ExcavatorEnv(ExcavatorBase):
 
     TASK = "dig"
     CARVE = True
-    REWARD_TERMS = ("delivered", "fill", "spill", "clearance", "contact", "time", "success")
+    REWARD_TERMS = (
+        "delivered",
+        "fill",
+        "spill",
+        "clearance",
+        "contact",
+        "time",
+        "success",
+        "approach",
+    )
     metadata = {
         **ExcavatorBase.metadata,
         "info_measures": {
@@ -225,6 +239,7 @@ class ExcavatorEnv(ExcavatorBase):
         contact: float = 10.0,
         time: float = 0.01,
         success: float = 10.0,
+        approach: float = 0.0,
         render_mode: str | None = None,
         render_size: tuple[int, int] = (480, 640),
     ) -> None:
@@ -238,10 +253,25 @@ class ExcavatorEnv(ExcavatorBase):
             contact=contact,
             time=time,
             success=success,
+            approach=approach,
         )
 
     def _sample_scene(self, rng: np.random.Generator) -> Scene:
         return sample_dig_scene(rng, self.m)
+
+    def subgoal(self) -> tuple[float, float, float]:
+        """The point the ``approach`` term draws the bucket tip to (m, frame M).
+
+        While the bucket holds less than the soil still owed to the truck
+        (``success_volume`` - truck soil): the middle of the dig zone, at the
+        marked depth below the ground there at reset. After: 1 m above the
+        centre of the truck's rim (where the bucket is emptied).
+        """
+        owed = self.success_volume - self.truck_soil
+        if owed > 0.0 and self.fill < owed:
+            return self._dig_goal
+        t = self.scene.truck
+        return (t.cx, t.cy, t.height + 1.0)
 
     def _task_reset(self) -> None:
         self._obs[self.layout["zone"]] = self.scene.zone.as_array()
@@ -250,6 +280,10 @@ class ExcavatorEnv(ExcavatorBase):
         self.outside_zone = 0.0
         self._last = (self.fill, self.truck_soil, self.spill)
         self.dig_fill = 0.0
+        zone = self.scene.zone
+        r = 0.5 * (zone.r_near + zone.r_far)
+        x, y = r * math.cos(zone.azimuth), r * math.sin(zone.azimuth)
+        self._dig_goal = (x, y, self.terrain.height_at(x, y) - zone.depth)
 
     def _on_cut(self, volume: float) -> None:
         i0, j0, cut = self.terrain.last_cut
@@ -277,6 +311,7 @@ class ExcavatorEnv(ExcavatorBase):
             "contact": -w["contact"] if contact else 0.0,
             "time": -w["time"],
             "success": w["success"] if success else 0.0,
+            "approach": -w["approach"] * math.dist(self.tip, self.subgoal()),
         }
         return terms, success, {}
 

@@ -32,3 +32,29 @@ def test_distance_term_is_weight_times_distance(env_id, weight):
         assert reward == pytest.approx(np.sum(terms))
         if terminated or truncated:
             break
+
+
+def test_dig_cycle_approach_term_follows_the_subgoal_from_zone_to_truck():
+    from motiongym.baselines import make_policy
+
+    env = gym.make("motiongym/Excavator-v0", approach=0.5)
+    policy = make_policy(
+        "motiongym/Excavator-v0", "dig-cycle", env.observation_space, env.action_space
+    )
+    observation, _ = env.reset(seed=5)
+    world = env.unwrapped
+    zone_goal = world.subgoal()
+    truck = world.scene.truck
+    goals = []
+    for _ in range(600):
+        action, _ = policy.predict(observation, deterministic=True)
+        observation, reward, terminated, truncated, info = env.step(action)
+        goal = world.subgoal()
+        goals.append(goal)
+        distance = float(np.linalg.norm(np.subtract(world.tip, goal)))
+        assert info["reward_approach"] == pytest.approx(-0.5 * distance, rel=1e-9)
+        if terminated or truncated:
+            break
+    assert info["is_success"]
+    assert goals[0] == zone_goal
+    assert goals[-1] == (truck.cx, truck.cy, truck.height + 1.0)
