@@ -18,8 +18,11 @@ policy         SB3 policy name (``MlpPolicy``, ``MultiInputPolicy``) required
 policy_kwargs  network and activation (mapping)                      {}
 env_kwargs     keywords for ``gym.make``                             {}
 normalize      VecNormalize: false, true, or a mapping of its kwargs false
-vec_env        ``dummy``, ``subproc`` or ``native`` (the ID's own     dummy
-               NumPy-batched vector env, see agents/vector.py)
+vec_env        ``dummy``, ``subproc``, ``native`` (the ID's own       dummy
+               NumPy-batched vector env, see agents/vector.py) or
+               ``pettingzoo`` (one policy shared by the agents of
+               the ID's PettingZoo version, see
+               agents/multiagent.py; ``n_envs`` counts its copies)
 eval_freq      steps between evaluations (over all envs)             10000
 n_eval_episodes episodes per evaluation                              5
 checkpoint_freq steps between checkpoints (over all envs)            50000
@@ -52,7 +55,7 @@ RUN_SETTINGS: dict[str, Any] = {
     "checkpoint_freq": 50_000,
 }
 REQUIRED = ("n_timesteps", "policy")
-VEC_ENVS = ("dummy", "subproc", "native")
+VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
 # Activation names accepted in policy_kwargs -> their torch.nn class names.
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU"}
 # Constructor arguments the run itself provides.

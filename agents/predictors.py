@@ -7,7 +7,10 @@ episode_start, deterministic)``: a scripted policy from
 * a scripted policy's name declared for the environment ID (``psa-cwa``);
 * a trained model: a ``.zip`` written by SB3, or a run folder written by
   ``motiongym train`` (holding ``model.zip`` and, if the run normalised
-  observations, ``vecnormalize.pkl``, which is applied here).
+  observations, ``vecnormalize.pkl``, which is applied here). A run whose
+  ``config.yml`` says ``vec_env: pettingzoo`` trained one policy for every
+  agent; it acts in the single-agent environment through
+  :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`.
 
 The algorithm of a bare ``.zip`` is read from the policy class saved in it
 (PPO and A2C share theirs, and either predicts the same way).
@@ -19,17 +22,25 @@ from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import yaml
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.save_util import load_from_zip_file
-from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecNormalize
 
 from motiongym.agents.environments import resolved_env_kwargs
 from motiongym.agents.errors import UsageError
+from motiongym.agents.multiagent import (
+    SharedPolicyPredictor,
+    SharedPolicyVecEnv,
+    check_single_agent_view,
+    parallel_factory,
+)
 from motiongym.agents.pretrained import pretrained_models, verify_manifest
 from motiongym.baselines import make_policy, scripted_policies
 
 MODEL_FILE = "model.zip"
 NORMALIZATION_FILE = "vecnormalize.pkl"
+CONFIG_FILE = "config.yml"
 
 
 def algorithm_classes() -> dict[str, type[BaseAlgorithm]]:
@@ -75,25 +86,52 @@ def saved_algorithm(path: Path) -> type[BaseAlgorithm]:
     raise UsageError(f"{path}: no known algorithm saves policies from {policy_module!r}")
 
 
-def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
-    """Load a trained model and check it was built for ``env``'s spaces."""
-    file = model_path(path)
-    model = saved_algorithm(file).load(file, device="cpu")
+def _check_spaces(model: BaseAlgorithm, owner: Any, file: Path, what: str) -> None:
+    """Raise unless ``model`` was built for ``owner``'s observation and action spaces."""
     for kind in ("observation_space", "action_space"):
-        trained, expected = getattr(model, kind), getattr(env, kind)
+        trained, expected = getattr(model, kind), getattr(owner, kind)
         if trained != expected:
             raise UsageError(
                 f"model {file} was trained for another {kind.replace('_', ' ')}: "
-                f"{trained} (the {env_id} environment has {expected})"
+                f"{trained} ({what} has {expected})"
             )
+
+
+def _normalized(model: BaseAlgorithm, file: Path, venv: VecEnv) -> Any:
+    """``model`` behind the run's saved observation normalisation, if it has one."""
     normalization_file = file.parent / NORMALIZATION_FILE
     if not normalization_file.is_file():
         return model
-    venv = DummyVecEnv([lambda: env])
     normalization = VecNormalize.load(str(normalization_file), venv)
     normalization.training = False
     normalization.norm_reward = False
     return NormalizedModel(model, normalization)
+
+
+def trained_shared_policy(file: Path) -> bool:
+    """Whether the run beside ``file`` shared one policy among agents (``vec_env: pettingzoo``)."""
+    config_file = file.parent / CONFIG_FILE
+    if not config_file.is_file():
+        return False
+    config = yaml.safe_load(config_file.read_text())
+    return isinstance(config, dict) and config.get("vec_env") == "pettingzoo"
+
+
+def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
+    """Load a trained model and check it was built for ``env``'s spaces.
+
+    A shared-policy run acts in ``env`` (the single-agent view) through
+    :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`.
+    """
+    file = model_path(path)
+    model = saved_algorithm(file).load(file, device="cpu")
+    if trained_shared_policy(file):
+        venv = SharedPolicyVecEnv(parallel_factory(env_id), n_copies=1)
+        _check_spaces(model, venv, file, f"a shared-policy agent of {env_id}")
+        check_single_agent_view(venv, env, env_id)
+        return SharedPolicyPredictor(_normalized(model, file, venv), venv.n_agents)
+    _check_spaces(model, env, file, f"the {env_id} environment")
+    return _normalized(model, file, DummyVecEnv([lambda: env]))
 
 
 def available_policies(env_id: str) -> list[str]:

@@ -12,6 +12,12 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
 callback's environment ``seed + 10_000``. Evaluations use seeds from
 ``motiongym.agents.evaluate.EVALUATION_SEED`` up, far from both.
+
+``vec_env: pettingzoo`` trains one policy shared by every agent of the ID's
+PettingZoo version (:mod:`motiongym.agents.multiagent`): ``n_envs`` copies,
+one SB3 environment per (copy, agent), so steps (``n_timesteps``,
+``eval_freq``, ``checkpoint_freq``) count agent steps, ``n_agents`` per
+environment step; the evaluation callback runs one copy.
 """
 
 from __future__ import annotations
@@ -44,7 +50,13 @@ from motiongym.agents.config import (
 )
 from motiongym.agents.environments import check_env_id, importable_id, short_name
 from motiongym.agents.errors import UsageError
-from motiongym.agents.predictors import MODEL_FILE, NORMALIZATION_FILE, algorithm_classes
+from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
+from motiongym.agents.predictors import (
+    CONFIG_FILE,
+    MODEL_FILE,
+    NORMALIZATION_FILE,
+    algorithm_classes,
+)
 from motiongym.agents.vector import VectorEnvAdapter
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
@@ -58,8 +70,20 @@ def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
     return kwargs
 
 
+def _monitored(venv, monitor_dir: Path | None, name: str) -> VecMonitor:
+    """``venv`` recording its episodes in ``monitor_dir/<name>.monitor.csv`` (if a folder)."""
+    if monitor_dir:
+        monitor_dir.mkdir(parents=True, exist_ok=True)
+    return VecMonitor(venv, str(monitor_dir / name) if monitor_dir else None)
+
+
 def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monitor_dir: Path | None):
     """The training environments as SB3 wants them, per the block's ``vec_env``."""
+    if config["vec_env"] == "pettingzoo":
+        factory = parallel_factory(env_id)
+        venv = SharedPolicyVecEnv(lambda: factory(**config["env_kwargs"]), n_envs)
+        venv.seed(seed)
+        return _monitored(venv, monitor_dir, "pettingzoo")
     if config["vec_env"] == "native":
         if not gym.spec(env_id).vector_entry_point:
             raise UsageError(f"{env_id} has no native vector environment; use dummy or subproc")
@@ -68,9 +92,7 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         )
         venv = VectorEnvAdapter(native)
         venv.seed(seed)
-        if monitor_dir:
-            monitor_dir.mkdir(parents=True, exist_ok=True)
-        return VecMonitor(venv, str(monitor_dir / "native") if monitor_dir else None)
+        return _monitored(venv, monitor_dir, "native")
     vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
     return make_vec_env(
         importable_id(env_id),
@@ -131,7 +153,7 @@ def train(
     run_dir.mkdir(parents=True, exist_ok=True)
     (run_dir / "command.txt").write_text(shlex.join(sys.argv) + "\n")
     resolved = {"env_id": env_id, "algo": algo, "seed": seed, "config_file": str(config_path)}
-    (run_dir / "config.yml").write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
+    (run_dir / CONFIG_FILE).write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
 
     n_envs = config["n_envs"]
     venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
@@ -156,15 +178,16 @@ def train(
     callbacks = [
         EvalCallbackClass(
             eval_venv,
-            eval_freq=max(config["eval_freq"] // n_envs, 1),
-            n_eval_episodes=config["n_eval_episodes"],
+            eval_freq=max(config["eval_freq"] // venv.num_envs, 1),
+            # Every slot of the one evaluation env runs n_eval_episodes episodes.
+            n_eval_episodes=config["n_eval_episodes"] * eval_venv.num_envs,
             best_model_save_path=str(eval_dir),
             log_path=str(eval_dir),
             deterministic=True,
             verbose=0,
         ),
         CheckpointCallback(
-            save_freq=max(config["checkpoint_freq"] // n_envs, 1),
+            save_freq=max(config["checkpoint_freq"] // venv.num_envs, 1),
             save_path=str(run_dir / "checkpoints"),
             name_prefix="model",
             save_vecnormalize=bool(config["normalize"]),
