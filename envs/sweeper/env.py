@@ -97,6 +97,14 @@ class SweeperEnv(gym.Env):
     The believed pose is clipped to the map's extent. A move whose rounded true pose leaves the
     reachable configurations is a bump.
 
+    ## Action masks (sb3-contrib's MaskablePPO)
+    ``action_masks()`` -> (3,) bool: forward is masked out when the
+    ``sensed`` window shows an obstacle (or the map's edge) in the row of
+    cells directly ahead of the footprint along the believed heading; turns
+    are always allowed. It is a function of the current observation, so it
+    gives a learner nothing the observation does not. With odometry noise an
+    allowed forward move can still bump.
+
     ## reset options
     ``start``: (row, col) of the footprint's top-left cell (a free
     configuration); ``heading``: 0..3.
@@ -377,6 +385,17 @@ class SweeperEnv(gym.Env):
             h, wd = self.scenario.obstacle.shape
             inside = (rr >= 0) & (rr < h) & (cc >= 0) & (cc < wd)
             np.add.at(self.coarse_obst, (rr[inside] // self.bh_, cc[inside] // self.bw_), 1.0)
+
+    def action_masks(self) -> np.ndarray:
+        """(3,) bool: which actions are allowed (see "Action masks" above)."""
+        R, w = self.R, self.w
+        ahead = (
+            self.win[R : R + w, R + w],  # east: the column right of the footprint
+            self.win[R - 1, R : R + w],  # north: the row above it
+            self.win[R : R + w, R - 1],  # west
+            self.win[R + w, R : R + w],  # south
+        )[self.h]
+        return np.array([not ahead.any(), True, True])
 
     def _obs(self, bump: bool) -> dict:
         S = self.S
