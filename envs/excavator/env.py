@@ -57,10 +57,12 @@ class ExcavatorReachEnv(ExcavatorBase):
     ``progress`` = progress * (e_prev - e) with ``e = |tip - target| (m) +
     |beta - beta*| (rad, 1 m per rad)``; ``clearance`` = -clearance on a step
     with cost; ``contact`` = -contact on contact; ``time`` = -time per step;
-    ``success`` = +success on success; ``distance`` = -distance * e every
-    step, 0 in the registered ID: a dense shaping that training configurations
-    switch on (``progress`` telescopes, so a policy parked 0.6 m short loses
-    only 0.6 in all). Success: tip within
+    ``success`` = +success on success; ``closeness`` = closeness *
+    exp(-e / closeness_scale) every step, 0 in the registered ID: a dense
+    shaping that training configurations switch on (``progress`` telescopes,
+    so a policy parked 0.6 m short loses only 0.6 in all). It is positive and
+    bounded, so ending an episode by a contact never pays, and a weight below
+    ``success`` / episode length keeps hovering worth less than arriving. Success: tip within
     ``tolerance_position`` (m) and bucket angle within ``tolerance_angle``
     (rad). Extra ``info``: ``position_error`` (m), ``angle_error`` (rad).
     """
@@ -74,7 +76,7 @@ class ExcavatorReachEnv(ExcavatorBase):
 
     TASK = "reach"
     CARVE = False
-    REWARD_TERMS = ("progress", "clearance", "contact", "time", "success", "distance")
+    REWARD_TERMS = ("progress", "clearance", "contact", "time", "success", "closeness")
     metadata = {
         **ExcavatorBase.metadata,
         "info_measures": {
@@ -100,7 +102,8 @@ class ExcavatorReachEnv(ExcavatorBase):
         contact: float = 10.0,
         time: float = 0.01,
         success: float = 10.0,
-        distance: float = 0.0,
+        closeness: float = 0.0,
+        closeness_scale: float = 0.5,  # m (and rad, 1 m per rad)
         render_mode: str | None = None,
         render_size: tuple[int, int] = (480, 640),
     ) -> None:
@@ -113,8 +116,9 @@ class ExcavatorReachEnv(ExcavatorBase):
             contact=contact,
             time=time,
             success=success,
-            distance=distance,
+            closeness=closeness,
         )
+        self.closeness_scale = float(closeness_scale)
 
     def _sample_scene(self, rng: np.random.Generator) -> Scene:
         return sample_reach_scene(rng, self.m)
@@ -143,7 +147,7 @@ class ExcavatorReachEnv(ExcavatorBase):
             "contact": -w["contact"] if contact else 0.0,
             "time": -w["time"],
             "success": w["success"] if success else 0.0,
-            "distance": -w["distance"] * err,
+            "closeness": w["closeness"] * math.exp(-err / self.closeness_scale),
         }
         self._err = err
         return terms, success, {"position_error": pos, "angle_error": ang}
@@ -179,11 +183,14 @@ class ExcavatorEnv(ExcavatorBase):
     completed cycle); ``spill`` = -spill * soil spilled (m3);
     ``clearance`` = -clearance on a step with cost; ``contact`` = -contact
     on contact; ``time`` = -time per step; ``success`` = +success on success;
-    ``approach`` = -approach * |tip - subgoal| (m) every step, 0 in the
-    registered ID: a dense shaping for training (configs) that draws the
-    bucket into the middle of the zone at the marked depth while it holds
-    less than the soil still owed to the truck, and 1 m over the truck bed's
-    centre after (:meth:`subgoal`).
+    ``approach`` = approach * (|tip_prev - g| - |tip - g|), the step's
+    progress (m) toward the subgoal g of :meth:`subgoal`, 0 in the registered
+    ID: a dense shaping for training (configs) that draws the bucket into the
+    middle of the zone at the marked depth while it holds less than the soil
+    still owed to the truck, and 1 m over the truck bed's centre after. Both
+    distances are to the current subgoal, so the term is a potential
+    difference within each phase: it never pays to end an episode early or
+    to hover.
     Success: at least ``success_volume`` m3 in the truck and the bucket empty
     (below 2 % of its capacity) - the cycle is over. Extra ``info``:
     ``dig_fill`` (m3, the largest bucket fill so far: the fill at the end of
@@ -284,6 +291,7 @@ class ExcavatorEnv(ExcavatorBase):
         r = 0.5 * (zone.r_near + zone.r_far)
         x, y = r * math.cos(zone.azimuth), r * math.sin(zone.azimuth)
         self._dig_goal = (x, y, self.terrain.height_at(x, y) - zone.depth)
+        self._tip_prev = tuple(self.tip)
 
     def _on_cut(self, volume: float) -> None:
         i0, j0, cut = self.terrain.last_cut
@@ -297,6 +305,8 @@ class ExcavatorEnv(ExcavatorBase):
         w = self.weights
         fill0, truck0, spill0 = self._last
         self._last = (self.fill, self.truck_soil, self.spill)
+        tip0, self._tip_prev = self._tip_prev, tuple(self.tip)
+        goal = self.subgoal()
         self.dig_fill = max(self.dig_fill, self.fill)
         success = (
             self.truck_soil >= self.success_volume and self.fill < 0.02 * self.m.bucket_capacity
@@ -311,7 +321,7 @@ class ExcavatorEnv(ExcavatorBase):
             "contact": -w["contact"] if contact else 0.0,
             "time": -w["time"],
             "success": w["success"] if success else 0.0,
-            "approach": -w["approach"] * math.dist(self.tip, self.subgoal()),
+            "approach": w["approach"] * (math.dist(tip0, goal) - math.dist(self.tip, goal)),
         }
         return terms, success, {}
 

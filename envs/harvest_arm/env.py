@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import gymnasium as gym
@@ -61,9 +62,12 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
     name): ``progress`` * decrease of the gripper-fruit distance (m);
     ``- clearance`` * max(0, 1 - d_min / safety_distance); ``- collision`` on
     contact (d_min <= 0); ``- effort`` * mean(action^2); ``success`` on arrival;
-    ``- distance`` * gripper-fruit distance (m) every step, 0 in the registered
-    IDs: a dense shaping that training configurations switch on (the progress
-    term telescopes, so a policy parked 0.5 m short loses only 5 in all).
+    ``closeness`` * exp(-d / ``closeness_scale``) every step (d: gripper-fruit
+    distance, m), 0 in the registered IDs: a dense shaping that training
+    configurations switch on (the progress term telescopes, so a policy parked
+    0.5 m short loses only 5 in all). It is positive and bounded, so ending an
+    episode early by a collision never pays, and a weight below ``success`` /
+    episode length keeps hovering worth less than arriving.
 
     Termination: the gripper within ``success_tolerance`` of the fruit centre,
     or a collision (if ``terminate_on_collision``). Truncation: the
@@ -110,7 +114,8 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         collision: float = 10.0,
         effort: float = 0.01,
         success: float = 10.0,
-        distance: float = 0.0,
+        closeness: float = 0.0,
+        closeness_scale: float = 0.1,  # m
         render_mode: str | None = None,
         width: int = 480,
         height: int = 360,
@@ -134,8 +139,9 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "collision": collision,
             "effort": effort,
             "success": success,
-            "distance": distance,
+            "closeness": closeness,
         }
+        self.closeness_scale = float(closeness_scale)
         self.render_mode, self.width, self.height = render_mode, width, height
 
         self.model, self.index = build_model(
@@ -272,7 +278,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "collision": -w["collision"] * float(collided),
             "effort": -w["effort"] * float(np.dot(a, a)) / len(a),
             "success": w["success"] * float(arrived),
-            "distance": -w["distance"] * d_fruit,
+            "closeness": w["closeness"] * math.exp(-d_fruit / self.closeness_scale),
         }
         self._d_fruit = d_fruit
         if self.render_mode is not None:

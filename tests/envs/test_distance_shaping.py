@@ -1,4 +1,4 @@
-"""The dense ``distance`` shaping term of the reaching tasks: off by default, exact when on."""
+"""The dense shaping terms for training: off by default, exact when on."""
 
 from __future__ import annotations
 
@@ -8,33 +8,34 @@ import pytest
 
 import motiongym  # noqa: F401
 
-# ID -> the info key(s) whose sum is the distance the term penalises
+# ID -> (the info keys whose sum is the distance, the default closeness scale)
 CASES = {
-    "motiongym/ExcavatorReach-v0": ("position_error", "angle_error"),
-    "motiongym/HarvestArmPlanar-v0": ("distance_to_fruit",),
-    "motiongym/HarvestArm-v0": ("distance_to_fruit",),
+    "motiongym/ExcavatorReach-v0": (("position_error", "angle_error"), 0.5),
+    "motiongym/HarvestArmPlanar-v0": (("distance_to_fruit",), 0.1),
+    "motiongym/HarvestArm-v0": (("distance_to_fruit",), 0.1),
 }
 
 
 @pytest.mark.parametrize("env_id", CASES)
 @pytest.mark.parametrize("weight", [0.0, 0.3])
-def test_distance_term_is_weight_times_distance(env_id, weight):
-    kwargs = {} if weight == 0.0 else {"distance": weight}
+def test_closeness_term_decays_with_the_distance(env_id, weight):
+    keys, scale = CASES[env_id]
+    kwargs = {} if weight == 0.0 else {"closeness": weight}
     env = gym.make(env_id, **kwargs)
     env.reset(seed=3)
     env.action_space.seed(3)
     for _ in range(5):
         _, reward, terminated, truncated, info = env.step(env.action_space.sample())
-        distance = sum(info[key] for key in CASES[env_id])
-        assert distance > 0.0
-        assert info["reward_distance"] == pytest.approx(-weight * distance, rel=1e-9, abs=1e-12)
+        distance = sum(info[key] for key in keys)
+        expected = weight * np.exp(-distance / scale)
+        assert info["reward_closeness"] == pytest.approx(expected, rel=1e-9, abs=1e-12)
         terms = [value for key, value in info.items() if key.startswith("reward_")]
         assert reward == pytest.approx(np.sum(terms))
         if terminated or truncated:
             break
 
 
-def test_dig_cycle_approach_term_follows_the_subgoal_from_zone_to_truck():
+def test_dig_cycle_approach_term_is_progress_toward_the_subgoal_from_zone_to_truck():
     from motiongym.baselines import make_policy
 
     env = gym.make("motiongym/Excavator-v0", approach=0.5)
@@ -47,12 +48,13 @@ def test_dig_cycle_approach_term_follows_the_subgoal_from_zone_to_truck():
     truck = world.scene.truck
     goals = []
     for _ in range(600):
+        tip = np.array(world.tip)
         action, _ = policy.predict(observation, deterministic=True)
         observation, reward, terminated, truncated, info = env.step(action)
         goal = world.subgoal()
         goals.append(goal)
-        distance = float(np.linalg.norm(np.subtract(world.tip, goal)))
-        assert info["reward_approach"] == pytest.approx(-0.5 * distance, rel=1e-9)
+        progress = np.linalg.norm(tip - goal) - np.linalg.norm(np.subtract(world.tip, goal))
+        assert info["reward_approach"] == pytest.approx(0.5 * progress, rel=1e-9, abs=1e-12)
         if terminated or truncated:
             break
     assert info["is_success"]
