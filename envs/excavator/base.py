@@ -154,9 +154,8 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         else:  # a vertical or point pipe: no plan-view bound
             self._pipe_line = ((a[0], a[1]), (0.0, 0.0), 0.0)
         self._pipe_zmax = max(a[2], b[2])
-        self._truck_edges = self.truck.edges()
         self._truck_radius = math.hypot(self.truck.half_length, self.truck.half_width)
-        self._truck_corners = [tuple(c) for c in self._truck_edges[0][:4, :2].tolist()]
+        self._truck_corners = self.truck.corners()
         self._radii = np.array(self.m.link_radius)
         self._max_r = max(self.m.link_radius)
         self._profile_key = None
@@ -309,15 +308,15 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
                 radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
             along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
             amin, amax = min(along), max(along)
-            bound = math.inf
+            links = []
             for k in range(3):
                 ra, rb = radial[k], radial[k + 1]
                 ahead = max(amin - max(ra, rb), min(ra, rb) - amax, 0.0)
                 above = min(heights[k], heights[k + 1]) - rim
-                bound = min(bound, max(side, ahead, above) - r_link[k])
+                links.append(max(side, ahead, above) - r_link[k])
+            bound = min(links)
         if bound < HORIZON:
-            starts, ends = np.array(pts[:3]), np.array(pts[1:])
-            self.truck_clear = truck_clearance(starts, ends, self._radii, truck, self._truck_edges)
+            self.truck_clear = truck_clearance(pts[:3], pts[1:], r_link, truck, links)
         else:
             self.truck_clear = bound
 

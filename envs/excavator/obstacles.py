@@ -3,17 +3,16 @@
 The arm is three capsules about the segments boom (foot pin to stick pin),
 stick (to the bucket pin) and bucket (pin to cutting edge), with the radii of
 :attr:`Machine.link_radius`. Clearance is the distance between surfaces
-(negative when they overlap), computed with :mod:`motiongym.envs.geometry`:
+(negative when they overlap):
 
 * pipe: a capsule of radius ``r`` about a straight segment below the ground
   (a utility located by a locate survey); clearance = segment-segment
-  distance - link radius - ``r``.
+  distance (:mod:`motiongym.envs.geometry`) - link radius - ``r``.
 * truck: the body as a box (footprint ``length x width`` turned by ``yaw``,
   from the ground up to the rim height; the open bed is inside it, so a bucket
-  must stay above the rim). The segment-box distance is exact: for disjoint
-  convex sets the closest pair is an end point against the box or a segment
-  against one of the 12 edges; a segment crossing the box (slab test) has
-  distance 0.
+  must stay above the rim). The segment-box distance is exact, computed in
+  the box's frame by :func:`segment_box_distance` (scalar math: the arm has
+  three links, where NumPy's per-call overhead would dominate).
 
 Broad phase: an environment step first takes cheap lower bounds (the pipe is
 below the arm's lowest point, a capsule's bounding sphere against the box) and
@@ -25,6 +24,7 @@ the reported clearance is that lower bound (it is then larger than
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,26 +78,22 @@ class Truck:
         u, v = self.to_local(x, y)
         return abs(u) <= self.half_length - margin and abs(v) <= self.half_width - margin
 
-    def point_distance(self, x: float, y: float, z: float) -> float:
-        """Distance from a point to the box (0 inside), scalar math."""
-        u, v = self.to_local(x, y)
-        du = max(abs(u) - self.half_length, 0.0)
-        dv = max(abs(v) - self.half_width, 0.0)
-        dz = max(-z, z - self.height, 0.0)
-        return math.sqrt(du * du + dv * dv + dz * dz)
-
-    def edges(self) -> tuple[np.ndarray, np.ndarray]:
-        """The 12 edges of the box in frame M: ``(starts, ends)``, each (12, 3)."""
-        hl, hw, h = self.half_length, self.half_width, self.height
-        corners = np.array([[sx * hl, sy * hw] for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+    def corners(self) -> list[tuple[float, float]]:
+        """The footprint's corners ``(x, y)`` in frame M (m), counter-clockwise."""
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        xy = corners @ np.array([[c, s], [-s, c]]) + (self.cx, self.cy)  # (4, 2)
-        low = np.column_stack([xy, np.zeros(4)])
-        high = np.column_stack([xy, np.full(4, h)])
-        nxt = [1, 2, 3, 0]
-        starts = np.concatenate([low, high, low])
-        ends = np.concatenate([low[nxt], high[nxt], high])
-        return starts, ends
+        hl, hw = self.half_length, self.half_width
+        return [
+            (self.cx + c * u - s * v, self.cy + s * u + c * v)
+            for u, v in ((-hl, -hw), (hl, -hw), (hl, hw), (-hl, hw))
+        ]
+
+    def box(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        """The box in its own frame (along, across, up): ``(low, high)`` corners (m)."""
+        return (-self.half_length, -self.half_width, 0.0), (
+            self.half_length,
+            self.half_width,
+            self.height,
+        )
 
 
 def pipe_clearance(starts: np.ndarray, ends: np.ndarray, radii: np.ndarray, pipe: Pipe) -> float:
@@ -108,51 +104,96 @@ def pipe_clearance(starts: np.ndarray, ends: np.ndarray, radii: np.ndarray, pipe
     return float(np.min(d - radii)) - pipe.radius
 
 
-def _segment_hits_box(p0, p1, truck: Truck) -> bool:
-    """Slab test: whether the segment ``p0 p1`` (frame M) meets the box."""
-    u0, v0 = truck.to_local(p0[0], p0[1])
-    u1, v1 = truck.to_local(p1[0], p1[1])
-    enter, leave = 0.0, 1.0
-    for a, b, lo, hi in (
-        (u0, u1, -truck.half_length, truck.half_length),
-        (v0, v1, -truck.half_width, truck.half_width),
-        (p0[2], p1[2], 0.0, truck.height),
-    ):
-        d = b - a
-        if d == 0.0:
-            if a < lo or a > hi:
-                return False
-            continue
-        t0, t1 = (lo - a) / d, (hi - a) / d
-        if t0 > t1:
-            t0, t1 = t1, t0
-        enter, leave = max(enter, t0), min(leave, t1)
-        if enter > leave:
-            return False
-    return True
+def segment_box_distance(
+    p0: Sequence[float], p1: Sequence[float], low: Sequence[float], high: Sequence[float]
+) -> float:
+    """Exact distance from the segment ``p0 p1`` to the box ``[low, high]`` (3D, one frame).
+
+    With ``p(t) = p0 + t (p1 - p0)``, the squared distance is
+    ``g(t) = sum_i dist(p_i(t), [low_i, high_i])^2``: convex, and quadratic
+    between the (at most six) parameters where the segment crosses a face
+    plane. The pieces are visited in order of ``t``; on each, the axes outside
+    the slab give ``g(t) = A t^2 + 2 B t + C`` with the minimiser ``-B / A``;
+    the first piece whose minimiser is not beyond its end holds the global
+    minimum (convexity), else the minimum is at ``t = 1``. The distance is
+    evaluated at that ``t`` from the point itself (not from ``A, B, C``, which
+    would lose digits to cancellation). 0 when the segment meets the box.
+    Agrees with the closest of the 12 box edges and the two end points
+    (Ericson's segment-segment routine, :mod:`motiongym.envs.geometry`) to
+    rounding (tested).
+    """
+    axes = (
+        (p0[0], p1[0] - p0[0], low[0], high[0]),
+        (p0[1], p1[1] - p0[1], low[1], high[1]),
+        (p0[2], p1[2] - p0[2], low[2], high[2]),
+    )  # (start, direction, slab low, slab high) per axis
+    cuts = [0.0]
+    for a, d, lo, hi in axes:
+        if d != 0.0:
+            t = (lo - a) / d
+            if 0.0 < t < 1.0:
+                cuts.append(t)
+            t = (hi - a) / d
+            if 0.0 < t < 1.0:
+                cuts.append(t)
+    cuts.sort()
+    cuts.append(1.0)
+    for t0, t1 in zip(cuts[:-1], cuts[1:], strict=True):
+        mid = 0.5 * (t0 + t1)
+        quad = lin = 0.0
+        for a, d, lo, hi in axes:
+            x = a + mid * d
+            if x < lo:
+                quad += d * d
+                lin += (a - lo) * d
+            elif x > hi:
+                quad += d * d
+                lin += (a - hi) * d
+        if quad == 0.0:  # g is constant on the piece (0 inside the box)
+            t = t0
+            break
+        t = -lin / quad
+        if t < t1:
+            t = max(t, t0)
+            break
+    else:
+        t = 1.0
+    total = 0.0
+    for a, d, lo, hi in axes:
+        x = a + t * d
+        gap = lo - x if x < lo else x - hi if x > hi else 0.0
+        total += gap * gap
+    return math.sqrt(total)
 
 
 def truck_clearance(
-    starts: np.ndarray,
-    ends: np.ndarray,
-    radii: np.ndarray,
+    starts: Sequence[Sequence[float]],
+    ends: Sequence[Sequence[float]],
+    radii: Sequence[float],
     truck: Truck,
-    edges: tuple[np.ndarray, np.ndarray] | None = None,
+    lower_bounds: Sequence[float] | None = None,
 ) -> float:
-    """Exact clearance of the capsules ``starts[k] -> ends[k]`` (k, 3) to the truck box (m).
+    """Exact clearance of the capsules ``starts[k] -> ends[k]`` (frame M) to the truck box (m).
 
-    ``edges`` may pass :meth:`Truck.edges`, computed once per scene.
+    ``lower_bounds`` (optional, one per capsule) are lower bounds of each
+    capsule's clearance: the capsules are visited from the smallest bound up,
+    and the visit stops at a bound not below the smallest clearance so far
+    (no later capsule can be closer), which leaves the minimum unchanged.
     """
-    e0, e1 = truck.edges() if edges is None else edges  # (12, 3) each
-    d_edges, _, _ = closest_points_between_segments(
-        starts[:, None, :], ends[:, None, :], e0[None], e1[None]
-    )  # (k, 12)
-    dist = d_edges.min(axis=1).tolist()
+    low, high = truck.box()
+    c, s = math.cos(truck.yaw), math.sin(truck.yaw)
+
+    def to_box(p: Sequence[float]) -> tuple[float, float, float]:
+        dx, dy = p[0] - truck.cx, p[1] - truck.cy
+        return c * dx + s * dy, -s * dx + c * dy, p[2]
+
+    order = range(len(radii))
+    if lower_bounds is not None:
+        order = sorted(order, key=lower_bounds.__getitem__)
     out = math.inf
-    for k, (p0, p1) in enumerate(zip(starts.tolist(), ends.tolist(), strict=True)):
-        if _segment_hits_box(p0, p1, truck):
-            d = 0.0
-        else:
-            d = min(dist[k], truck.point_distance(*p0), truck.point_distance(*p1))
-        out = min(out, d - float(radii[k]))
-    return out
+    for k in order:
+        if lower_bounds is not None and lower_bounds[k] >= out:
+            break
+        d = segment_box_distance(to_box(starts[k]), to_box(ends[k]), low, high) - radii[k]
+        out = min(out, d)
+    return float(out)

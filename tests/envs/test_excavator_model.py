@@ -19,9 +19,11 @@ from motiongym.envs.excavator.obstacles import (  # noqa: E402
     Pipe,
     Truck,
     pipe_clearance,
+    segment_box_distance,
     truck_clearance,
 )
 from motiongym.envs.excavator.soil import Terrain, cutting_force, speed_fraction  # noqa: E402
+from motiongym.envs.geometry import closest_points_between_segments  # noqa: E402
 
 
 def _rot(axis: str, a: float) -> np.ndarray:
@@ -209,3 +211,70 @@ def test_truck_clearance_known_cases_and_dense_sampling():
         assert exact <= sampled + 1e-9
         if exact > 0:
             assert exact == pytest.approx(sampled, abs=0.2)
+
+
+def _box_distance_by_edges(p0, p1, low, high):
+    """Segment-box distance the general way: 0 if the slabs' parameter ranges
+    overlap in [0, 1] (the segment meets the box), else the closest of the 12
+    edges (:mod:`motiongym.envs.geometry`) and the two end points."""
+    d = p1 - p0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_a, t_b = (low - p0) / d, (high - p0) / d
+    inside = (p0 >= low) & (p0 <= high)  # an axis the segment runs along
+    enter = np.where(d == 0, np.where(inside, -np.inf, np.inf), np.minimum(t_a, t_b))
+    leave = np.where(d == 0, np.where(inside, np.inf, -np.inf), np.maximum(t_a, t_b))
+    if max(enter.max(), 0.0) <= min(leave.min(), 1.0):
+        return 0.0
+    corners = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
+    corners = np.where(corners == 1, high, low)  # (8, 3); index bits x, y, z
+    pairs = [(i, i | bit) for i in range(8) for bit in (1, 2, 4) if not i & bit]  # the 12 edges
+    e0, e1 = corners[[a for a, _ in pairs]], corners[[b for _, b in pairs]]
+    edges, _, _ = closest_points_between_segments(p0, p1, e0, e1)
+    ends = [np.linalg.norm(p - np.clip(p, low, high)) for p in (p0, p1)]
+    return min(edges.min(), *ends)
+
+
+def test_segment_box_distance_equals_the_edge_construction():
+    rng = np.random.default_rng(11)
+    low, high = np.array([-2.5, -1.2, 0.0]), np.array([2.5, 1.2, 2.8])
+    kinds = {"meets": 0, "apart": 0}
+    for k in range(600):
+        p0, p1 = rng.uniform([-6, -5, -2], [6, 5, 6], size=(2, 3))
+        if k % 5 == 0:  # along one axis, and a point
+            p1 = p0.copy()
+            p1[k % 3] += rng.uniform(-6, 6) if k % 10 else 0.0
+        if k % 7 == 0:  # an end point on a face plane
+            p0[k % 3] = high[k % 3]
+        got = segment_box_distance(tuple(p0), tuple(p1), tuple(low), tuple(high))
+        want = _box_distance_by_edges(p0, p1, low, high)
+        assert got == pytest.approx(want, abs=1e-12)
+        kinds["meets" if want == 0.0 else "apart"] += 1
+    assert min(kinds.values()) > 100
+
+
+def test_segment_box_distance_known_cases():
+    low, high = (0.0, 0.0, 0.0), (2.0, 1.0, 1.0)
+    # Over the top, parallel to it: the height above.
+    assert segment_box_distance((-1.0, 0.5, 3.0), (3.0, 0.5, 3.0), low, high) == 2.0
+    # Diagonal past an edge: the segment x + y = 4 at z = 0.5 is sqrt(2)/2 from (2, 1).
+    got = segment_box_distance((4.0, 0.0, 0.5), (0.0, 4.0, 0.5), low, high)
+    assert got == pytest.approx(math.sqrt(0.5), abs=1e-15)
+    # A point beyond a corner, and a segment through the box.
+    assert segment_box_distance((3.0, 2.0, 2.0), (3.0, 2.0, 2.0), low, high) == pytest.approx(
+        math.sqrt(3.0)
+    )
+    assert segment_box_distance((-1.0, -1.0, -1.0), (3.0, 2.0, 2.0), low, high) == 0.0
+
+
+def test_truck_clearance_bounds_only_skip_capsules_that_cannot_be_closest():
+    rng = np.random.default_rng(12)
+    truck = Truck(cx=1.0, cy=6.0, yaw=-0.4, half_length=2.5, half_width=1.2, height=2.8)
+    radii = [0.35, 0.25, 0.45]
+    for _ in range(200):
+        pts = [tuple(p) for p in rng.uniform([-6, 0, -1], [6, 12, 6], size=(4, 3))]
+        links = zip(pts[:3], pts[1:], radii, strict=True)
+        each = [truck_clearance([a], [b], [r], truck) for a, b, r in links]
+        slack = rng.uniform(0.0, 2.0, 3)  # any lower bounds: the exact values less some slack
+        bounds = [e - s for e, s in zip(each, slack, strict=True)]
+        assert truck_clearance(pts[:3], pts[1:], radii, truck) == min(each)
+        assert truck_clearance(pts[:3], pts[1:], radii, truck, bounds) == min(each)
