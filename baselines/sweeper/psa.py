@@ -49,6 +49,27 @@ Choices where the paper is open (documented and tested):
   sweeps at least the cell that made its point a target, so this ends.
   (Dropping the segment lost those pieces until CWA's scan found them,
   usually from the far side of the map.)
+- LIFO by runs: every entry carries the run that pushed it, and a pop takes,
+  among the entries of the latest run still on the stack, the one whose
+  restart point is nearest (grid distance in the known map); older runs'
+  entries wait, in LIFO order, until that run's entries are done or stale.
+  The paper prefers a stack because "the point taken from it is likely near
+  where the previous sweep ended"; the order in which one run pushed its
+  segments says nothing about which is nearer at the run's end (a run of
+  lanes pushes its entries along its length, and ends at one end of it).
+- The heading of a run restarted at a popped point (section 3.1 does not
+  say): along the popped segment, as the lane that pushed it ran, unless
+  lanes across cost less for the unswept stretch at the restart point
+  (:func:`restart_heading`, :func:`sweep_cost`: ``ceil(across / w)`` lanes,
+  so a corridor 7 cells wide is swept in lanes across it, each of which
+  sweeps fresh floor, rather than in three lanes along it that sweep 9
+  rows for 7).
+
+  Mean travel ratio (travel / (area / w)) over seeds 0-9 on the room, the
+  apartment and the maze, and over the reproduction's 50 procedural maps:
+  plain stack order and segment heading 1.445 / 1.697 / 1.546 / 1.445;
+  LIFO by runs alone 1.365 / 1.636 / 1.537 / 1.422; restart heading alone
+  1.445 / 1.630 / 1.498 / 1.429; both 1.366 / 1.580 / 1.486 / 1.405.
 """
 
 from __future__ import annotations
@@ -153,17 +174,74 @@ def lane_open(occ_fp_next: np.ndarray, swept_edge: np.ndarray) -> bool:
     return not (occ_fp_next == 1).any() and not swept_edge.all()
 
 
+def stretches(todo: np.ndarray, cfg: tuple[int, int]) -> tuple[int, int, int, int]:
+    """Per heading (E, N, W, S): how many ``todo`` configurations follow ``cfg`` in a row."""
+    h, wd = todo.shape
+    out = []
+    for k in range(4):
+        n, (r, c) = 0, cfg
+        while True:
+            r, c = r + int(DR[k]), c + int(DC[k])
+            if not (0 <= r < h and 0 <= c < wd and todo[r, c]):
+                break
+            n += 1
+        out.append(n)
+    return tuple(out)
+
+
+def sweep_cost(along: int, across: int, w: int) -> int:
+    """Travel of a boustrophedon over an ``along x across`` rectangle of cells, lanes ``along``.
+
+    ``ceil(across / w)`` lanes of ``along - w`` moves each, joined by shifts
+    summing to ``across - w`` moves. Lanes across a 7-cell corridor (``w = 3``)
+    cost 3 lanes' worth less than along it: three lanes along it sweep 9
+    rows for 7.
+    """
+    return -(-across // w) * max(along - w, 0) + max(across - w, 0)
+
+
+def restart_heading(stretch: tuple[int, int, int, int], heading: int, side: int, w: int):
+    """The heading and shift side a run restarted at a popped point sweeps with.
+
+    ``stretch[k]``: configurations covering unswept cells met in a row from
+    the restart point going in heading ``k`` (0 E, 1 N, 2 W, 3 S). The
+    region is taken as the rectangle these stretches span, in cells; the
+    lanes keep the segment's axis (``heading``, ``side``) unless lanes
+    along the other axis cost less by :func:`sweep_cost`, in which case the
+    run heads the longer way along that axis and shifts to the longer side.
+    """
+    extent = (stretch[0] + stretch[2] + w, stretch[1] + stretch[3] + w)  # cells E-W, N-S
+    axis = heading % 2
+    if sweep_cost(extent[1 - axis], extent[axis], w) >= sweep_cost(
+        extent[axis], extent[1 - axis], w
+    ):
+        return heading, side
+    new = max((1 - axis, 3 - axis), key=lambda k: stretch[k])
+    return new, max((left_of(new), right_of(new)), key=lambda k: stretch[k])
+
+
 class PsaStack:
-    """The LIFO stack of side segments (the paper prefers it to a FIFO queue)."""
+    """The LIFO stack of side segments (the paper prefers it to a FIFO queue).
+
+    Each entry carries the number of the run that pushed it; :meth:`top_run`
+    lists the entries of the latest run still on the stack.
+    """
 
     def __init__(self) -> None:
         self.items: list[Segment] = []
+        self.runs: list[int] = []
 
-    def push(self, seg: Segment) -> None:
+    def push(self, seg: Segment, run: int = 0) -> None:
         self.items.append(seg)
+        self.runs.append(run)
 
-    def pop(self) -> Segment:
-        return self.items.pop()
+    def pop(self, k: int = -1) -> tuple[Segment, int]:
+        """Remove entry ``k`` (the top by default); return it with its run."""
+        return self.items.pop(k), self.runs.pop(k)
+
+    def top_run(self) -> list[int]:
+        """Indices of the entries pushed by the same run as the top entry, bottom to top."""
+        return [k for k, run in enumerate(self.runs) if run == self.runs[-1]]
 
     def __len__(self) -> int:
         return len(self.items)

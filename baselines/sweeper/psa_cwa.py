@@ -53,6 +53,7 @@ class Memory:
     run_side: int | None = None
     lane_start: tuple[int, int] | None = None
     first_lane: bool = True  # no shift yet in this run (its side may still flip)
+    run: int = 0  # number of the current PSA run (stack entries carry the run that pushed them)
     stack: psa.PsaStack = field(default_factory=psa.PsaStack)
     cwa_stack: list = field(default_factory=list)
     cwa_cells: np.ndarray | None = None
@@ -138,7 +139,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return FORWARD  # step 1: straight on, sweeping
         for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
             if self._strip_unswept(m, seg):
-                m.stack.push(seg)
+                m.stack.push(seg, m.run)
         # step 4: shift one width to the run's side, at the blocking point or,
         # where the side is blocked there, at the nearest point back along the lane;
         # a run's first shift may take the other side when the run's side is closed
@@ -214,41 +215,43 @@ class PsaCwaPolicy(ScriptedPolicy):
         return None
 
     def _pop(self, m: Memory, r: int, c: int, h: int) -> int | None:
-        """Pop segments until one still holds work and can be reached; transfer there."""
-        if not len(m.stack):
-            m.mode = "cwa_scan"
-            return None
+        """Take the next stack entry that still holds work and transfer there.
+
+        LIFO by runs: the candidates are the entries the latest run on the
+        stack pushed, and of those the one whose restart point is nearest
+        (:mod:`.psa`'s docstring); a group with no work left is dropped (the
+        paper's skip). The ``nearest`` ablation considers every entry.
+        """
         origin, occ, swept, cfree, cur = self._known(m, r, c)
         dist = world.bfs_distance(cfree, cur)
         todo = psa.covers_unswept(occ, swept, self.w)
-        if self.pop_order == "nearest":
-            best, best_k = None, None
-            for k, seg in enumerate(m.stack.items):
-                found = None
-                for j in range(self.w):
-                    found = found or psa.first_target(
-                        psa.toward_lane(seg, j), origin, dist >= 0, todo, dist
-                    )
-                if found is not None:
-                    d = dist[found[0][0] - origin[0], found[0][1] - origin[1]]
-                    if best is None or d < best:
-                        best, best_k = d, k
-            if best_k is not None:
-                m.stack.items.append(m.stack.items.pop(best_k))
-        while len(m.stack):
-            seg = m.stack.pop()
+
+        def restart(seg: psa.Segment) -> tuple[tuple[int, int], int] | None:
             for j in range(self.w):  # one width away, else closer to the lane
                 found = psa.first_target(psa.toward_lane(seg, j), origin, dist >= 0, todo, dist)
                 if found is not None:
-                    break
-            if found is None:
-                continue  # already swept (the paper's skip) or out of reach
-            target, heading = found
+                    return found
+            return None
+
+        while len(m.stack):
+            group = range(len(m.stack)) if self.pop_order == "nearest" else m.stack.top_run()
+            found = {k: t for k in group if (t := restart(m.stack.items[k])) is not None}
+            if not found:
+                for k in reversed(group):
+                    m.stack.pop(k)
+                continue
+            k = min(
+                found,
+                key=lambda k: (dist[found[k][0][0] - origin[0], found[k][0][1] - origin[1]], -k),
+            )
+            seg, run = m.stack.pop(k)
+            target, heading = found[k]
             path = quadtree.plan(cfree, cur, (target[0] - origin[0], target[1] - origin[1]))
-            if path is None:
+            if path is None:  # pragma: no cover - BFS reached it, the quadtree must too
                 continue
             if self.repush:
-                m.stack.push(seg)  # what this run leaves of it is found on a later pop
+                m.stack.push(seg, run)  # what the new run leaves of it is found on a later pop
+            m.run += 1
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             m.goal, m.run_heading, m.run_side = target, heading, seg.side
             m.mode = "transfer"
@@ -268,8 +271,16 @@ class PsaCwaPolicy(ScriptedPolicy):
                 return None
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             return None
+        m.run_heading, m.run_side = psa.restart_heading(
+            self._stretches(m, r, c), m.run_heading, m.run_side, self.w
+        )
         m.mode, m.lane_start, m.first_lane = "lane", (r, c), True
         return None
+
+    def _stretches(self, m: Memory, r: int, c: int) -> tuple[int, int, int, int]:
+        """Per heading: known-map configurations covering unswept cells in a row from ``(r, c)``."""
+        _, occ, swept, cfree, cur = self._known(m, r, c)
+        return psa.stretches(psa.covers_unswept(occ, swept, self.w) & cfree, cur)
 
     # -------------------------------------------------------------- CWA modes
     def _cwa_scan(self, m: Memory, r: int, c: int, h: int) -> int | None:
@@ -294,32 +305,22 @@ class PsaCwaPolicy(ScriptedPolicy):
     def _restart_psa(self, m: Memory, r, c, origin, cfree, cur, wide, targets) -> None:
         """Transfer to the nearest wide leftover and sweep it with a new PSA run.
 
-        The run's heading is the one with the longest stretch of leftover
-        configurations ahead; its shift side the perpendicular with more
-        leftover cells beside the first lane.
+        The run heads along the longest stretch of leftover configurations
+        and shifts to the perpendicular with the longer one; on arrival
+        :func:`.psa.restart_heading` may turn the lanes to the other axis.
         """
         dist = world.bfs_distance(cfree, cur)
         d = np.where(wide & (dist >= 0), dist, np.iinfo(np.int64).max)
         target = divmod(int(np.argmin(d)), d.shape[1])
         todo = psa.covers_unswept(np.where(targets, 0, 1), targets, self.w) & cfree
-        h, wd = todo.shape
-
-        def run_length(k: int, cfg: tuple[int, int]) -> int:
-            n, (rr, cc) = 0, cfg
-            while True:
-                rr, cc = rr + int(DR[k]), cc + int(DC[k])
-                if not (0 <= rr < h and 0 <= cc < wd and todo[rr, cc]):
-                    return n
-                n += 1
-
-        heading = max(range(4), key=lambda k: run_length(k, target))
-        side = max(
-            (psa.left_of(heading), psa.right_of(heading)), key=lambda k: run_length(k, target)
-        )
+        stretch = psa.stretches(todo, target)
+        heading = max(range(4), key=lambda k: stretch[k])
+        side = max((psa.left_of(heading), psa.right_of(heading)), key=lambda k: stretch[k])
         path = quadtree.plan(cfree, cur, target)
         m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
         m.goal = (target[0] + origin[0], target[1] + origin[1])
         m.run_heading, m.run_side, m.mode = heading, side, "transfer"
+        m.run += 1
         m.log.append(("restart", (r, c), m.goal))
 
     def _remaining(self, m: Memory, cells: np.ndarray) -> np.ndarray:

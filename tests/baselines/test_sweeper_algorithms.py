@@ -81,7 +81,47 @@ def test_lane_open_and_stack_is_lifo() -> None:
     a, b = psa.Segment((0, 0), 0, 1, 1), psa.Segment((5, 5), 2, 3, 3)
     stack.push(a)
     stack.push(b)
-    assert stack.pop() == b and stack.pop() == a and len(stack) == 0
+    assert stack.pop() == (b, 0) and stack.pop() == (a, 0) and len(stack) == 0
+
+
+def test_stack_groups_entries_by_the_run_that_pushed_them() -> None:
+    stack = psa.PsaStack()
+    segs = [psa.Segment((k, 0), 0, 1, 1) for k in range(5)]
+    for seg, run in zip(segs, (0, 0, 1, 1, 1), strict=True):
+        stack.push(seg, run)
+    assert stack.top_run() == [2, 3, 4]  # the latest run's entries, bottom to top
+    assert stack.pop(3) == (segs[3], 1)  # any of them may be taken
+    stack.pop()
+    stack.pop()
+    assert stack.top_run() == [0, 1]  # then the run before, LIFO
+
+
+def test_sweep_cost_counts_lanes_and_shifts() -> None:
+    # a 20-cell corridor 7 cells wide, w = 3: along it 3 lanes of 17 moves and
+    # 4 moves of shifts; across it 7 lanes of 4 moves and 17 moves of shifts
+    assert psa.sweep_cost(20, 7, 3) == 3 * 17 + 4
+    assert psa.sweep_cost(7, 20, 3) == 7 * 4 + 17
+    assert psa.sweep_cost(3, 3, 3) == 0  # one configuration sweeps it
+
+
+def test_restart_heading_turns_lanes_across_a_corridor_only() -> None:
+    # popped at the west end of an east-west corridor 7 cells wide, 20 long:
+    # stretches E 17, N 0, W 0, S 4 configurations (cells 20 x 7)
+    stretch = (17, 0, 0, 4)
+    # a segment heading east (lanes along the corridor): turned across it,
+    # heading south (the longer way on that axis), shifting east
+    assert psa.restart_heading(stretch, 0, 3, 3) == (3, 0)
+    # a segment already across the corridor keeps its heading and side
+    assert psa.restart_heading(stretch, 3, 0, 3) == (3, 0)
+    # a square region keeps the segment's axis
+    assert psa.restart_heading((6, 0, 0, 6), 0, 3, 3) == (0, 3)
+
+
+def test_stretches_count_todo_configurations_in_a_row() -> None:
+    todo = np.zeros((6, 8), bool)
+    todo[2, 1:7] = True
+    todo[0:5, 3] = True
+    assert psa.stretches(todo, (2, 3)) == (3, 2, 2, 2)  # E, N, W, S
 
 
 def test_cwa_scan_order_top_right_to_bottom_left() -> None:
