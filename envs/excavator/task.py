@@ -58,13 +58,19 @@ class DigZone:
         each side of it (the bucket's half width).
         """
         c, s = math.cos(self.azimuth), math.sin(self.azimuth)
-        along = c * _XS[:, None] + s * _YS[None, :]
-        across = -s * _XS[:, None] + c * _YS[None, :]
-        return (
-            (along >= self.r_near - ZONE_MARGIN)
-            & (along <= self.r_far + ZONE_MARGIN)
-            & (np.abs(across) <= half_width + ZONE_MARGIN)
-        )
+        near, far = self.r_near - ZONE_MARGIN, self.r_far + ZONE_MARGIN
+        side = half_width + ZONE_MARGIN
+        # Only the cells of the strip's bounding box (one cell wider) are tested.
+        xs = [c * r - s * t for r in (near, far) for t in (-side, side)]
+        ys = [s * r + c * t for r in (near, far) for t in (-side, side)]
+        i0, i1 = _cell_range(min(xs), max(xs), GRID_ORIGIN[0], GRID_SHAPE[0])
+        j0, j1 = _cell_range(min(ys), max(ys), GRID_ORIGIN[1], GRID_SHAPE[1])
+        x, y = _XS[i0:i1, None], _YS[None, j0:j1]
+        along = c * x + s * y
+        across = -s * x + c * y
+        inside = np.zeros(GRID_SHAPE, dtype=bool)
+        inside[i0:i1, j0:j1] = (along >= near) & (along <= far) & (np.abs(across) <= side)
+        return inside
 
     def as_array(self) -> np.ndarray:
         """``[x_near, y_near, x_far, y_far, depth]``, shape (5,)."""
@@ -89,13 +95,21 @@ _YS = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL  # (ny,)
 _FADE = np.clip((np.hypot(_XS[:, None], _YS[None, :]) - PAD_RADIUS) / 1.0, 0.0, 1.0)
 
 
+def _cell_range(lo: float, hi: float, origin: float, n: int) -> tuple[int, int]:
+    """Indices ``[i0, i1)`` of the cells overlapping ``[lo, hi]`` (m), one more each side."""
+    i0 = math.floor((lo - origin) / GRID_CELL) - 1
+    i1 = math.floor((hi - origin) / GRID_CELL) + 2
+    return min(max(i0, 0), n), min(max(i1, 0), n)
+
+
 def sample_heights(rng: np.random.Generator) -> np.ndarray:
     """Initial ground heights, shape ``GRID_SHAPE``.
 
-    Two plane waves ``amp sin(k (cos d x + sin d y) + phase)``, each computed
-    as ``sin A cos B + cos A sin B`` from outer products (separable in x, y).
+    Two plane waves ``amp sin(k (cos d x + sin d y) + phase)``, each
+    ``amp (sin A cos B + cos A sin B)`` (separable in x, y): both waves are
+    one matrix product ``(nx, 4) @ (4, ny)``.
     """
-    h = np.zeros(GRID_SHAPE)
+    columns, rows = [], []
     for _ in range(2):
         k = rng.uniform(0.3, 0.8)
         direction = rng.uniform(0.0, 2 * math.pi)
@@ -103,8 +117,9 @@ def sample_heights(rng: np.random.Generator) -> np.ndarray:
         amp = rng.uniform(0.0, 0.075)
         a = k * math.cos(direction) * _XS + phase  # (nx,)
         b = k * math.sin(direction) * _YS  # (ny,)
-        h += amp * (np.outer(np.sin(a), np.cos(b)) + np.outer(np.cos(a), np.sin(b)))
-    return h * _FADE
+        columns += [amp * np.sin(a), amp * np.cos(a)]
+        rows += [np.cos(b), np.sin(b)]
+    return (np.column_stack(columns) @ np.vstack(rows)) * _FADE
 
 
 def sample_truck(rng: np.random.Generator) -> Truck:
