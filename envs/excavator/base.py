@@ -156,7 +156,6 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         self._pipe_zmax = max(a[2], b[2])
         self._truck_radius = math.hypot(self.truck.half_length, self.truck.half_width)
         self._truck_corners = self.truck.corners()
-        self._radii = np.array(self.m.link_radius)
         self._max_r = max(self.m.link_radius)
         self._profile_key = None
         self._profile_table = profile_table(self.m.L0, self.m.d2)
@@ -284,15 +283,15 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
             a = (ox - px) * -uy + (oy - py) * ux
             b = c1 * -uy + s1 * ux
             g = [a + b * r for r in radial]
-            bound = math.inf
+            links = []
             for k in range(3):
                 g0, g1 = g[k], g[k + 1]
                 plan = 0.0 if g0 * g1 <= 0.0 else min(abs(g0), abs(g1))
                 vertical = max(min(heights[k], heights[k + 1]) - zmax, 0.0)
-                bound = min(bound, math.hypot(plan, vertical) - r_link[k] - rp)
+                links.append(math.hypot(plan, vertical) - r_link[k] - rp)
+            bound = min(links)
         if bound < HORIZON:
-            starts, ends = np.array(pts[:3]), np.array(pts[1:])
-            self.pipe_clear = pipe_clearance(starts, ends, self._radii, self.pipe)
+            self.pipe_clear = pipe_clearance(pts[:3], pts[1:], r_link, self.pipe, links)
         else:
             self.pipe_clear = bound
         # Truck: first its circumscribed circle's lateral gap and the rim height.

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.geometry import closest_points_between_segments
+_EPS = 1e-12  # as in motiongym.envs.geometry
 
 
 @dataclass(frozen=True)
@@ -96,12 +96,66 @@ class Truck:
         )
 
 
-def pipe_clearance(starts: np.ndarray, ends: np.ndarray, radii: np.ndarray, pipe: Pipe) -> float:
-    """Exact clearance of the capsules ``starts[k] -> ends[k]`` (k, 3) to the pipe (m)."""
-    d, _, _ = closest_points_between_segments(
-        starts, ends, np.asarray(pipe.a, float), np.asarray(pipe.b, float)
-    )
-    return float(np.min(d - radii)) - pipe.radius
+def segment_distance(
+    p0: Sequence[float], p1: Sequence[float], q0: Sequence[float], q1: Sequence[float]
+) -> float:
+    """Distance between the segments ``p0 p1`` and ``q0 q1`` (3D), scalar math.
+
+    The same formulas, in the same order, as
+    :func:`motiongym.envs.geometry.closest_points_between_segments`
+    (Ericson 2005, section 5.1.9, degenerate cases folded in) for one pair:
+    NumPy's per-call overhead dominates on a handful of segments. Equal to it
+    to rounding (tested).
+    """
+    d1 = (p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2])
+    d2 = (q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2])
+    r = (p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2])
+    a = max(d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2], _EPS)
+    e = max(d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2], _EPS)
+    b = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]
+    c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2]
+    f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2]
+    denom = a * e - b * b
+    if denom <= _EPS * a * e:  # parallel: the point of p nearest q0
+        s = -c * e / (a * e)
+    else:
+        s = (b * f - c * e) / denom
+    s = min(max(s, 0.0), 1.0)
+    t = (b * s + f) / e
+    clamped = min(max(t, 0.0), 1.0)
+    if t != clamped:
+        s = min(max((b * clamped - c) / a, 0.0), 1.0)
+    x = r[0] + s * d1[0] - clamped * d2[0]
+    y = r[1] + s * d1[1] - clamped * d2[1]
+    z = r[2] + s * d1[2] - clamped * d2[2]
+    return math.sqrt(x * x + y * y + z * z)
+
+
+def _visiting_order(n: int, lower_bounds: Sequence[float] | None) -> Sequence[int]:
+    """Capsule indices, from the smallest lower bound up when bounds are given."""
+    if lower_bounds is None:
+        return range(n)
+    return sorted(range(n), key=lower_bounds.__getitem__)
+
+
+def pipe_clearance(
+    starts: Sequence[Sequence[float]],
+    ends: Sequence[Sequence[float]],
+    radii: Sequence[float],
+    pipe: Pipe,
+    lower_bounds: Sequence[float] | None = None,
+) -> float:
+    """Exact clearance of the capsules ``starts[k] -> ends[k]`` (frame M) to the pipe (m).
+
+    ``lower_bounds`` as in :func:`truck_clearance`.
+    """
+    out = math.inf
+    for k in _visiting_order(len(radii), lower_bounds):
+        if lower_bounds is not None and lower_bounds[k] >= out:
+            break
+        d = segment_distance(starts[k], ends[k], pipe.a, pipe.b)
+        out = min(out, d - radii[k] - pipe.radius)
+    return float(out)
 
 
 def segment_box_distance(
@@ -187,11 +241,8 @@ def truck_clearance(
         dx, dy = p[0] - truck.cx, p[1] - truck.cy
         return c * dx + s * dy, -s * dx + c * dy, p[2]
 
-    order = range(len(radii))
-    if lower_bounds is not None:
-        order = sorted(order, key=lower_bounds.__getitem__)
     out = math.inf
-    for k in order:
+    for k in _visiting_order(len(radii), lower_bounds):
         if lower_bounds is not None and lower_bounds[k] >= out:
             break
         d = segment_box_distance(to_box(starts[k]), to_box(ends[k]), low, high) - radii[k]

@@ -20,6 +20,7 @@ from motiongym.envs.excavator.obstacles import (  # noqa: E402
     Truck,
     pipe_clearance,
     segment_box_distance,
+    segment_distance,
     truck_clearance,
 )
 from motiongym.envs.excavator.soil import Terrain, cutting_force, speed_fraction  # noqa: E402
@@ -278,3 +279,31 @@ def test_truck_clearance_bounds_only_skip_capsules_that_cannot_be_closest():
         bounds = [e - s for e, s in zip(each, slack, strict=True)]
         assert truck_clearance(pts[:3], pts[1:], radii, truck) == min(each)
         assert truck_clearance(pts[:3], pts[1:], radii, truck, bounds) == min(each)
+
+
+def test_segment_distance_equals_the_shared_routine():
+    rng = np.random.default_rng(13)
+    for k in range(400):
+        p0, p1, q0, q1 = rng.uniform(-3, 3, size=(4, 3))
+        if k % 4 == 1:  # parallel, overlapping or not
+            q1 = q0 + rng.uniform(-2, 2) * (p1 - p0)
+        if k % 4 == 2:  # a point against a segment
+            p1 = p0.copy()
+        if k % 8 == 3:  # two points
+            p1, q1 = p0.copy(), q0.copy()
+        want, _, _ = closest_points_between_segments(p0, p1, q0, q1)
+        got = segment_distance(tuple(p0), tuple(p1), tuple(q0), tuple(q1))
+        assert got == pytest.approx(float(want), abs=1e-12)
+
+
+def test_pipe_clearance_bounds_only_skip_capsules_that_cannot_be_closest():
+    rng = np.random.default_rng(14)
+    pipe = Pipe(a=(-4.0, -5.0, -2.0), b=(6.0, 5.0, -2.5), radius=0.15)
+    radii = [0.35, 0.25, 0.45]
+    for _ in range(200):
+        pts = [tuple(p) for p in rng.uniform([-6, -6, -3], [6, 6, 3], size=(4, 3))]
+        links = zip(pts[:3], pts[1:], radii, strict=True)
+        each = [pipe_clearance([a], [b], [r], pipe) for a, b, r in links]
+        bounds = [e - s for e, s in zip(each, rng.uniform(0.0, 2.0, 3), strict=True)]
+        assert pipe_clearance(pts[:3], pts[1:], radii, pipe) == min(each)
+        assert pipe_clearance(pts[:3], pts[1:], radii, pipe, bounds) == min(each)
