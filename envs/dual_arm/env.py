@@ -72,7 +72,13 @@ class DualArmCellEnv(gym.Env):
       since the episode ends when both arms are done);
     * ``collision``: ``-collision`` on the step that collides;
     * ``clearance``: ``-clearance * max(0, 1 - d / clearance_distance)``,
-      ``d = d(R1, R2)``.
+      ``d = d(R1, R2)``;
+    * ``advance``: ``advance * (dp_1 / N_1 + dp_2 / N_2)``, the step's progress
+      of both arms as fractions of their paths (``2 * advance`` over a
+      completed task), 0 in the registered ID: a potential-based shaping for
+      training (configs), since ``time`` alone ranks waiting out the 20 s
+      (-20) near finishing (-8 to -12) for a learner that has not yet found
+      how to finish.
 
     ## Episode
     Terminated when both arms are done (success) or on collision
@@ -90,7 +96,7 @@ class DualArmCellEnv(gym.Env):
     ``control`` ("both" | "robot_2"), ``task`` ("colliding": pairs that collide
     if started together and are collision free one after the other; "any";
     "paper": the fixed paper case), ``safety_margin`` (m), ``clearance_distance``
-    (m), reward weights ``time``, ``collision``, ``clearance``, ``render_mode``
+    (m), reward weights ``time``, ``collision``, ``clearance``, ``advance``, ``render_mode``
     ("rgb_array"). ``reset(options={"task": ...})`` overrides the task mode.
 
     ## Version history
@@ -119,6 +125,7 @@ class DualArmCellEnv(gym.Env):
         time: float = 1.0,
         collision: float = 10.0,
         clearance: float = 0.1,
+        advance: float = 0.0,
         render_mode: str | None = None,
     ) -> None:
         if control not in CONTROLS:
@@ -136,6 +143,7 @@ class DualArmCellEnv(gym.Env):
             "time": float(time),
             "collision": float(collision),
             "clearance": float(clearance),
+            "advance": float(advance),
         }
         self.render_mode = render_mode
         n_act = 2 if control == "both" else 1
@@ -170,6 +178,7 @@ class DualArmCellEnv(gym.Env):
         w = self.world
         if w.p2 < w.n2:  # robot 2 not done before this step
             self._wait2 += (1.0 - a2) * DT
+        done_before = w.p1 / w.n1 + w.p2 / w.n2
         w.advance(a1, a2)
         d = w.distance
         collided = d <= self.safety_margin
@@ -178,8 +187,9 @@ class DualArmCellEnv(gym.Env):
             "time": -weights["time"] * DT,
             "collision": -weights["collision"] if collided else 0.0,
             "clearance": -weights["clearance"] * max(0.0, 1.0 - d / self.clearance_distance),
+            "advance": weights["advance"] * (w.p1 / w.n1 + w.p2 / w.n2 - done_before),
         }
-        reward = terms["time"] + terms["collision"] + terms["clearance"]
+        reward = sum(terms.values())
         terminated = collided or (w.p1 >= w.n1 and w.p2 >= w.n2)
         return w.observation(), float(reward), terminated, False, self._info(collided, terms)
 

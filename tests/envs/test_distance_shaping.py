@@ -60,3 +60,23 @@ def test_dig_cycle_approach_term_is_progress_toward_the_subgoal_from_zone_to_tru
     assert info["is_success"]
     assert goals[0] == zone_goal
     assert goals[-1] == (truck.cx, truck.cy, truck.height + 1.0)
+
+
+def test_dual_arm_advance_term_sums_to_twice_its_weight_over_a_completed_task():
+    from motiongym.baselines import make_policy
+
+    env = gym.make("motiongym/DualArmCell-v0", advance=3.0)
+    policy = make_policy(
+        "motiongym/DualArmCell-v0", "sequential", env.observation_space, env.action_space
+    )
+    observation, info = env.reset(seed=2)
+    assert info["reward_advance"] == 0.0
+    total, done = 0.0, False
+    while not done:
+        action, _ = policy.predict(observation, deterministic=True)
+        observation, reward, terminated, truncated, info = env.step(action)
+        assert info["reward_advance"] >= 0.0
+        total += info["reward_advance"]
+        done = terminated or truncated
+    assert info["is_success"]
+    assert total == pytest.approx(2 * 3.0, rel=1e-9)
