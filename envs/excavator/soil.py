@@ -43,6 +43,8 @@ import numpy as np
 
 from motiongym.envs.excavator.config import Machine
 
+_ROUNDING = 1e-9  # m: covers the rounding of the edge heights interpolated between steps
+
 
 def cutting_force(depth: float, width: float, m: Machine) -> float:
     """Simplified fundamental earthmoving equation ``F(d)`` in N (0 above ground)."""
@@ -146,6 +148,12 @@ class Terrain:
         ys = (edge0[0][1], edge0[1][1], edge1[0][1], edge1[1][1])
         i0, i1 = int((min(xs) - self.x0) * inv), int((max(xs) - self.x0) * inv) + 1
         j0, j1 = int((min(ys) - self.y0) * inv), int((max(ys) - self.y0) * inv) + 1
+        # Most sweeps pass over the ground: nothing is cut when the edge stays
+        # above every cell of the sweep's bounding box (on the map), which
+        # holds every sample's cell.
+        box = self.h[max(i0, 0) : min(i1, self.nx), max(j0, 0) : min(j1, self.ny)]
+        if box.size == 0 or min(z0, z1) - _ROUNDING >= box.max():
+            return 0.0
         weights, along = _sweep_weights(n_s, n_u)  # (n_s * n_u, 4), (n_s * n_u,)
         pts = weights @ np.array((edge0[0], edge0[1], edge1[0], edge1[1]))  # (n_s * n_u, 2)
         zs = z0 + along * (z1 - z0)

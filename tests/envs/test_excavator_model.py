@@ -152,6 +152,23 @@ def test_carving_a_strip_removes_its_volume_and_conserves_soil():
     assert t.carve(edge0, edge1, -0.5, -0.5, free_capacity=10.0) == 0.0  # already cut
 
 
+def test_a_sweep_over_the_ground_changes_nothing_and_one_into_it_cuts():
+    t = _flat()
+    t.h[30:40, 40:60] = 0.2  # a mound under the sweep's end
+    edge0 = (np.array([-2.0, -0.6]), np.array([-2.0, 0.6]))
+    edge1 = (np.array([-1.0, -0.6]), np.array([-1.0, 0.6]))
+    before = t.h.copy()
+    assert t.carve(edge0, edge1, 0.3, 0.2, free_capacity=10.0) == 0.0
+    assert t.version == 0 and t.last_cut_depth == 0.0 and t.last_cut is None
+    np.testing.assert_array_equal(t.h, before)
+    # Down to 0.1 m at the end: 12 cells across, and along the second half cell
+    # 30 + m down to its deeper sample, 0.3 - 0.2 (2m + 1.5) / 20, for m = 5..9.
+    removed = t.carve(edge0, edge1, 0.3, 0.1, free_capacity=10.0)
+    depths = [0.2 - (0.3 - 0.2 * (2 * m + 1.5) / 20) for m in range(5, 10)]
+    assert removed == pytest.approx(12 * 0.01 * sum(depths), rel=1e-9) and t.version == 1
+    assert t.h[30:40, 40:60].min() == pytest.approx(0.2 - depths[-1]) and t.h.max() == 0.2
+
+
 def test_a_full_bucket_takes_only_its_free_capacity():
     t = _flat()
     edge0 = (np.array([2.0, -0.6]), np.array([2.0, 0.6]))
