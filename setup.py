@@ -22,5 +22,9 @@ for name, folder in PACKAGE_DIRS.items():
 setup(
     packages=packages,
     package_dir=PACKAGE_DIRS,
-    package_data={"": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.pkl"]},
+    package_data={
+        "": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.pkl"],
+        # shipped models: pretrained/<ID>/<label>/ are folders, not packages
+        "motiongym.agents": ["pretrained/*/*/*"],
+    },
 )
