@@ -21,7 +21,13 @@ def test_reproduce_sweeper_quick(tmp_path, capsys) -> None:
     )
     sp = results["start_position"]
     assert sp["starts"] > 30 and 0.0 <= sp["spread"] < 1.0
-    assert all(row["coverage"] == 1.0 for row in results["orientation"]["rows"])
+    ori = results["orientation"]
+    assert [row["heading"] for row in ori["rows"]] == ["east", "north", "west", "south"]
+    assert all(row["coverage"] == 1.0 for row in ori["rows"])
+    travel = [row["travel"] for row in ori["rows"]]
+    assert ori["spread"] == (max(travel) - min(travel)) / min(travel)
+    assert ori["starts"] == 5 and ori["spread_starts_max"] >= ori["spread_starts_mean"]
+    assert all(row["coverage"] == 1.0 for row in ori["walls_turned"]["rows"])
     rows = results["odometry"]["rows"]
     assert rows[0]["coverage"] == 1.0 and rows[0]["heading_noise"] == 0.0
     assert min(r["coverage"] for r in rows[1:]) < 1.0  # noise costs coverage
