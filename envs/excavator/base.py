@@ -102,6 +102,7 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         self.action_space = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
         self._renderer = None
         self.scene: Scene | None = None
+        self._reward_keys = {k: f"reward_{k}" for k in self.REWARD_TERMS}
 
     # ----------------------------------------------------------------- hooks
     def _sample_scene(self, rng: np.random.Generator) -> Scene:
@@ -164,8 +165,7 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         self._obs[self.layout["truck"]] = self.truck.as_array()
         self._obs[self.layout["pipe"]] = self.pipe.as_array()
         self._forward()
-        self._prev_edge = self._edge()
-        self._prev_tip_z = self.tip[2]
+        self._prev_tip, self._prev_swing = self.tip, self.q[0]
         self._clearances()
         self._task_reset()
         info = self._info(dict.fromkeys(self.REWARD_TERMS, 0.0), False)
@@ -212,28 +212,31 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         self.tip = self.points[3]
         self.beta = self.q[1] + self.q[2] + self.q[3]
 
-    def _edge(self) -> tuple[tuple[float, float], tuple[float, float]]:
+    def _edge(
+        self, tip: tuple[float, float, float], swing: float
+    ) -> tuple[tuple[float, float], tuple[float, float]]:
         """End points (x, y) of the cutting edge, across the boom plane at the tip."""
         half = 0.5 * self.m.bucket_width
-        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
-        x, y = self.tip[0], self.tip[1]
+        c1, s1 = math.cos(swing), math.sin(swing)
+        x, y = tip[0], tip[1]
         return (x + half * s1, y - half * c1), (x - half * s1, y + half * c1)
 
     def _carve_and_pour(self) -> None:
         m = self.m
         z = self.tip[2]
         top = self.terrain.max_height
-        edge = self._edge()
-        if z < top or self._prev_tip_z < top:
+        prev_tip, prev_swing = self._prev_tip, self._prev_swing
+        if z < top or prev_tip[2] < top:
             free = m.bucket_capacity - self.fill
-            taken = self.terrain.carve(self._prev_edge, edge, self._prev_tip_z, z, free)
+            edge0 = self._edge(prev_tip, prev_swing)
+            edge1 = self._edge(self.tip, self.q[0])
+            taken = self.terrain.carve(edge0, edge1, prev_tip[2], z, free)
             if taken > 0.0:
                 self.fill += taken
                 self._on_cut(taken)
         else:
             self.terrain.last_cut_depth = 0.0
-        self._prev_edge = edge
-        self._prev_tip_z = z
+        self._prev_tip, self._prev_swing = self.tip, self.q[0]
         if self.fill > 0.0 and -math.cos(self.beta) < POUR_NZ:
             amount = min(self.fill, m.bucket_capacity * self.dt / POUR_TIME)
             self.fill -= amount
@@ -347,18 +350,21 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         cost = (
             self.pipe_clear < self.pipe_safety or self.pipe_clear <= 0.0 or self.truck_clear <= 0.0
         )
-        info = {f"reward_{k}": float(v) for k, v in terms.items()}
+        keys = self._reward_keys
+        info = {keys[k]: float(v) for k, v in terms.items()}
         info.update(
-            is_success=bool(success),
-            cost=1.0 if cost else 0.0,
-            pipe_clearance=float(self.pipe_clear),
-            truck_clearance=float(self.truck_clear),
-            pipe_contact=float(self.pipe_clear <= 0.0),
-            truck_contact=float(self.truck_clear <= 0.0),
-            bucket_fill=float(self.fill),
-            truck_soil=float(self.truck_soil),
-            spill=float(self.spill),
-            elapsed=float(self.elapsed),
+            {
+                "is_success": bool(success),
+                "cost": 1.0 if cost else 0.0,
+                "pipe_clearance": float(self.pipe_clear),
+                "truck_clearance": float(self.truck_clear),
+                "pipe_contact": 1.0 if self.pipe_clear <= 0.0 else 0.0,
+                "truck_contact": 1.0 if self.truck_clear <= 0.0 else 0.0,
+                "bucket_fill": float(self.fill),
+                "truck_soil": float(self.truck_soil),
+                "spill": float(self.spill),
+                "elapsed": float(self.elapsed),
+            }
         )
         return info
 

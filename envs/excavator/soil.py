@@ -166,6 +166,15 @@ class Terrain:
             i, j, zs = i[keep], j[keep], zs[keep]
             i0, i1 = max(i0, 0), min(i1, self.nx)
             j0, j1 = max(j0, 0), min(j1, self.ny)
+        if free_capacity <= 0.0:
+            # A full bucket takes nothing (the cut scaled to zero below), so only
+            # the depth of cut is needed: the largest ``h - z`` over the samples.
+            depth = float((self.h[i, j] - zs).max())
+            if depth > 0.0:
+                self.last_cut_depth = depth
+                self.last_cut = (i0, j0, np.zeros((i1 - i0, j1 - j0)))
+                self.version += 1
+            return 0.0
         patch = self.h[i0:i1, j0:j1]  # a view
         old = patch.copy()
         np.minimum.at(self.h, (i, j), zs)
