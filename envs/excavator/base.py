@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+import struct
 from typing import Any
 
 import gymnasium as gym
@@ -50,6 +51,10 @@ POUR_TIME = 1.0  # s to empty a full bucket
 HORIZON = 1.0  # m: exact clearances below this bound
 RESET_OPTIONS = ("q0",)
 PROFILE_BINS_PER_DEG = 10
+# Observation entries 0-12 (q, qdot, tip, bucket angle, fill) written as float32
+# straight into the buffer: the same rounding as NumPy's cast, without
+# converting a list (the observation is C-contiguous, native float32).
+_STATE = struct.Struct("=13f")
 
 
 @functools.lru_cache(maxsize=8)
@@ -341,7 +346,7 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         The static slices (task, truck, pipe) are written once at reset.
         """
         buf = self._obs
-        buf[0:13] = self.q + self.qdot + [*self.tip, self.beta, self.fill]
+        _STATE.pack_into(buf, 0, *self.q, *self.qdot, *self.tip, self.beta, self.fill)
         buf[13:37] = self._profile()
         self._task_obs(buf)
         return buf.copy()
