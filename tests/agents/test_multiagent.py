@@ -93,6 +93,25 @@ def test_each_slot_acts_for_its_own_arm():
     assert rewards[0] == rewards[1]  # the shared reward, once per agent
 
 
+def test_one_copy_steps_as_the_single_agent_view():
+    venv = _venv(1)
+    env = make_env(DUAL_ARM)
+    venv.seed(11)
+    slots = venv.reset()
+    observation, _ = env.reset(seed=11)
+    actions = np.random.default_rng(1).uniform(0, 1, (400, 2)).astype(np.float32)
+    for action in actions:
+        np.testing.assert_array_equal(slots[:, :OBS], [observation, observation])
+        slots, rewards, dones, infos = venv.step(action.reshape(2, 1))
+        observation, reward, terminated, truncated, info = env.step(action)
+        np.testing.assert_allclose(rewards, [reward, reward], rtol=1e-6)
+        assert dones.all() == (terminated or truncated)
+        if dones.all():
+            np.testing.assert_array_equal(infos[0]["terminal_observation"][:OBS], observation)
+            break
+    assert dones.all()  # the colliding tasks end well within 400 random steps
+
+
 def test_a_truncated_copy_ends_every_slot_reports_its_terminal_observation_and_resets():
     venv = _venv(2, max_steps=5)
     venv.seed(0)
