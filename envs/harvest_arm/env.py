@@ -54,6 +54,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
     | qdot (n) | joint rates applied last step | rad/s | joint |
     | points (P * dim) | joint points, base first, gripper last | m | world |
     | fruit (dim) | fruit centre | m | world |
+    | fruit_error (dim) | fruit centre - gripper (as Reacher's fingertip - target) | m | world |
     | obstacles (K * (2 dim + 2)) | per slot: ends a, b (b = a: sphere), radius, is_bar | m | - |
     | mask (K) | 1 for a present obstacle | - | - |
     | distances (L * K) | clearance link l to obstacle k, clipped at 1 m (1 m if absent) | m | - |
@@ -172,6 +173,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         self._s_sin, self._s_cos = self._slices["sin_q"], self._slices["cos_q"]
         self._s_qdot, self._s_points = self._slices["qdot"], self._slices["points"]
         self._s_dist = self._slices["distances"]
+        self._s_fruit_error = self._slices["fruit_error"]
         self._q = np.zeros(n)
         self._renderer: mujoco.Renderer | None = None
         self._path: list[np.ndarray] = []
@@ -313,6 +315,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         obs[self._s_qdot] = qdot
         points = d.site_xpos[self._sites, : self.dim]
         obs[self._s_points] = points.ravel()
+        obs[self._s_fruit_error] = self._fruit - points[-1]
         obs[self._s_dist] = clear
         self._gripper = points[-1]
 

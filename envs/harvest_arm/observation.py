@@ -42,6 +42,7 @@ class ObservationLayout:
             ("qdot", self.dof),
             ("points", self.n_points * self.dim),
             ("fruit", self.dim),
+            ("fruit_error", self.dim),
             ("obstacles", self.n_slots * self.obstacle_width),
             ("mask", self.n_slots),
             ("distances", self.n_links * self.n_slots),
@@ -69,6 +70,7 @@ class ObservationLayout:
         low[s["qdot"]], high[s["qdot"]] = -speeds, speeds
         low[s["mask"]], high[s["mask"]] = 0.0, 1.0
         low[s["distances"]], high[s["distances"]] = -POSITION_BOUND, DISTANCE_CLIP
+        low[s["fruit_error"]], high[s["fruit_error"]] = -2 * POSITION_BOUND, 2 * POSITION_BOUND
         return low, high
 
     def parse(self, observation: np.ndarray) -> dict[str, np.ndarray]:
@@ -82,6 +84,7 @@ class ObservationLayout:
             "qdot": o[s["qdot"]],  # (n,) rad/s
             "points": o[s["points"]].reshape(self.n_points, d),  # (P, dim) m
             "fruit": o[s["fruit"]],  # (dim,) m
+            "fruit_error": o[s["fruit_error"]],  # (dim,) m, fruit - gripper
             "a": obstacles[:, :d],  # (K, dim) m
             "b": obstacles[:, d : 2 * d],  # (K, dim) m
             "radius": obstacles[:, 2 * d],  # (K,) m

@@ -1,4 +1,4 @@
-"""The dense shaping terms for training: off by default, exact when on."""
+"""Learnability aids: dense shaping terms (off by default, exact when on), error features."""
 
 from __future__ import annotations
 
@@ -80,3 +80,14 @@ def test_dual_arm_advance_term_sums_to_twice_its_weight_over_a_completed_task():
         done = terminated or truncated
     assert info["is_success"]
     assert total == pytest.approx(2 * 3.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("env_id", ["motiongym/HarvestArmPlanar-v0", "motiongym/HarvestArm-v0"])
+def test_harvest_observation_holds_the_fruit_error(env_id):
+    env = gym.make(env_id)
+    layout = env.unwrapped.layout
+    observation, info = env.reset(seed=4)
+    for _ in range(3):
+        error = layout.parse(observation)["fruit_error"]
+        assert np.linalg.norm(error) == pytest.approx(info["distance_to_fruit"], rel=1e-5)
+        observation, *_, info = env.step(env.action_space.sample())

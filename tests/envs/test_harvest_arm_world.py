@@ -142,7 +142,8 @@ def test_reward_terms_sum_and_info_keys():
         _, reward, terminated, truncated, info = env.step(env.action_space.sample())
         terms = {k: v for k, v in info.items() if k.startswith("reward_")}
         assert set(terms) == {
-            f"reward_{t}" for t in ("progress", "clearance", "collision", "effort", "success")
+            f"reward_{t}"
+            for t in ("progress", "clearance", "collision", "effort", "success", "closeness")
         }
         assert sum(terms.values()) == pytest.approx(reward)
         assert info["cost"] == float(info["min_distance"] < 0.03 or info["collision"])
