@@ -14,8 +14,8 @@ callback's environment ``seed + 10_000``. Evaluations use seeds from
 ``motiongym.agents.evaluate.EVALUATION_SEED`` up, far from both.
 
 ``vec_env: pettingzoo`` trains one policy shared by every agent of the ID's
-PettingZoo version (:mod:`motiongym.agents.multiagent`): ``n_envs`` copies,
-one SB3 environment per (copy, agent), so steps (``n_timesteps``,
+PettingZoo version (:mod:`motiongym.agents.multiagent`): ``n_envs`` copies
+made with ``env_kwargs``, one SB3 environment per (copy, agent), so steps (``n_timesteps``,
 ``eval_freq``, ``checkpoint_freq``) count agent steps, ``n_agents`` per
 environment step; the evaluation callback runs one copy.
 """
