@@ -49,9 +49,10 @@ class ExcavatorReachEnv(ExcavatorBase):
     bucket as fractions of the hydraulic limits ``rate_max`` (1.15, 0.6, 0.7,
     1.0 rad/s); one step is ``dt`` = 0.1 s. The ground is not carved here.
 
-    Observation (54,), float32: see :mod:`motiongym.envs.excavator.observation`
+    Observation (58,), float32: see :mod:`motiongym.envs.excavator.observation`
     (q 0-3, qdot 4-7, tip 8-10, bucket angle 11, fill 12, ground profile
-    13-36, target 37-40 [x, y, z, beta], truck 41-46, pipe 47-53).
+    13-36, target 37-40 [x, y, z, beta], target - tip 41-44 [dx, dy, dz,
+    dbeta], truck 45-50, pipe 51-57).
 
     Reward terms (weights are keyword arguments of the same name):
     ``progress`` = progress * (e_prev - e) with ``e = |tip - target| (m) +
@@ -129,7 +130,16 @@ class ExcavatorReachEnv(ExcavatorBase):
         ang = abs(math.remainder(self.beta - t[3], 2 * math.pi))
         return pos, ang
 
+    def _task_obs(self, buf: np.ndarray) -> None:
+        t, tip = self.scene.target, self.tip
+        i = self._error_index
+        buf[i] = t[0] - tip[0]
+        buf[i + 1] = t[1] - tip[1]
+        buf[i + 2] = t[2] - tip[2]
+        buf[i + 3] = math.remainder(t[3] - self.beta, 2 * math.pi)
+
     def _task_reset(self) -> None:
+        self._error_index = self.layout["target_error"].start
         self._obs[self.layout["target"]] = self.scene.target
         pos, ang = self._errors()
         self._err = pos + ang

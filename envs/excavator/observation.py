@@ -16,6 +16,8 @@ fill         1      soil in the bucket (m3)
 profile      24     ground height in the boom plane at 1.0, 1.4, ... 10.2 m
                     from the swing axis along azimuth ``q1`` (m)
 target       4      (reach) target tip x, y, z (m) and bucket angle (rad)
+target_error 4      (reach) target - tip (m) and target - bucket angle (rad, in
+                    [-pi, pi]), as Reacher's fingertip - target
 zone         5      (dig) zone near end x, y, far end x, y (m), marked depth (m)
 truck_soil   1      (dig) soil delivered into the truck (m3)
 truck        6      truck footprint centre x, y (m), yaw (rad), half length,
@@ -35,7 +37,7 @@ from motiongym.envs.excavator.config import Machine
 PROFILE_RADII = 1.0 + 0.4 * np.arange(24)  # (24,) m: 1.0 to 10.2 m, the machine's reach
 
 _COMMON = (("q", 4), ("qdot", 4), ("tip", 3), ("bucket", 1), ("fill", 1), ("profile", 24))
-_TASK = {"reach": (("target", 4),), "dig": (("zone", 5), ("truck_soil", 1))}
+_TASK = {"reach": (("target", 4), ("target_error", 4)), "dig": (("zone", 5), ("truck_soil", 1))}
 _SCENE = (("truck", 6), ("pipe", 7))
 TASKS = tuple(_TASK)
 
@@ -68,6 +70,7 @@ def bounds(task: str, m: Machine) -> tuple[np.ndarray, np.ndarray]:
     put("profile", -10.0, 10.0)
     if task == "reach":
         put("target", [-30.0, -30.0, -30.0, -3 * math.pi], [30.0, 30.0, 30.0, 3 * math.pi])
+        put("target_error", [-60.0, -60.0, -60.0, -math.pi], [60.0, 60.0, 60.0, math.pi])
     else:
         put("zone", [-30.0] * 4 + [0.0], [30.0] * 4 + [10.0])
         put("truck_soil", 0.0, 100.0)

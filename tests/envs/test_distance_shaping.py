@@ -91,3 +91,22 @@ def test_harvest_observation_holds_the_fruit_error(env_id):
         error = layout.parse(observation)["fruit_error"]
         assert np.linalg.norm(error) == pytest.approx(info["distance_to_fruit"], rel=1e-5)
         observation, *_, info = env.step(env.action_space.sample())
+
+
+def test_reach_observation_holds_the_target_error():
+    from motiongym.envs.excavator.observation import layout
+
+    env = gym.make("motiongym/ExcavatorReach-v0")
+    slices = layout("reach")
+    observation, info = env.reset(seed=4)
+    for _ in range(3):
+        error = observation[slices["target_error"]]
+        target = observation[slices["target"]]
+        tip, beta = observation[slices["tip"]], observation[slices["bucket"]][0]
+        np.testing.assert_allclose(error[:3], target[:3] - tip, atol=1e-5)
+        assert np.linalg.norm(error[:3]) == pytest.approx(info["position_error"], rel=1e-5)
+        assert abs(error[3]) == pytest.approx(info["angle_error"], abs=1e-6)
+        assert abs(error[3]) <= np.pi and error[3] == pytest.approx(
+            np.remainder(target[3] - beta + np.pi, 2 * np.pi) - np.pi, abs=1e-5
+        )
+        observation, *_, info = env.step(env.action_space.sample())
