@@ -97,6 +97,8 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         if not dt > 0:
             raise ValueError(f"dt must be positive, got {dt!r}")
         self.m = machine_from_kwargs(machine)
+        m = self.m
+        self._joints = tuple(zip(range(4), m.rate_max, m.q_min, m.q_max, strict=True))  # per joint
         self.dt = float(dt)
         self.pipe_safety = float(pipe_safety)
         self.render_mode = render_mode
@@ -188,8 +190,7 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
             if depth > 0.0:
                 scale = speed_fraction(depth, m.bucket_width, m)
         q, qdot = self.q, self.qdot
-        limits = zip(range(4), values, m.rate_max, m.q_min, m.q_max, strict=True)
-        for k, v, rmax, lo, hi in limits:
+        for (k, rmax, lo, hi), v in zip(self._joints, values, strict=True):
             rate = (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * rmax * scale
             new = q[k] + rate * dt
             if new < lo or new > hi:
@@ -308,13 +309,16 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
         centre = -s1 * (truck.cx - ox) + c1 * (truck.cy - oy)
         bound = max(abs(centre) - self._truck_radius, lowest - rim) - self._max_r
         if bound < HORIZON:
-            lateral = [-s1 * (x - ox) + c1 * (y - oy) for x, y in self._truck_corners]
+            lateral, along = [], []  # the corners across and along the plane
+            for x, y in self._truck_corners:
+                dx, dy = x - ox, y - oy
+                lateral.append(-s1 * dx + c1 * dy)
+                along.append(c1 * dx + s1 * dy)
             lo, hi = min(lateral), max(lateral)
             side = 0.0 if lo * hi <= 0.0 else min(abs(lo), abs(hi))
+            amin, amax = min(along), max(along)
             if radial is None:
                 radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
-            along = [c1 * (x - ox) + s1 * (y - oy) for x, y in self._truck_corners]
-            amin, amax = min(along), max(along)
             links = []
             for k in range(3):
                 ra, rb = radial[k], radial[k + 1]
