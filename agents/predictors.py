@@ -23,6 +23,7 @@ from typing import Any
 
 import gymnasium as gym
 import yaml
+from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.save_util import load_from_zip_file
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecNormalize
@@ -59,9 +60,30 @@ class NormalizedModel:
         self.model = model
         self.normalization = normalization
 
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+    def predict(self, observation, state=None, episode_start=None, deterministic=True, **kwargs):
         observation = self.normalization.normalize_obs(observation)
-        return self.model.predict(observation, state, episode_start, deterministic)
+        return self.model.predict(observation, state, episode_start, deterministic, **kwargs)
+
+
+class MaskedModel:
+    """A MaskablePPO model given its environment's action masks at every prediction.
+
+    The harness steps ``env`` with this predictor's actions, so
+    ``env.unwrapped.action_masks()`` is the mask of the observation being
+    acted on (for the sweeper, a function of that observation alone).
+    """
+
+    def __init__(self, model: Any, env: gym.Env) -> None:
+        if not hasattr(env.unwrapped, "action_masks"):
+            raise UsageError(f"{env.spec.id if env.spec else env} gives no action masks")
+        self.model = model
+        self.env = env
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        masks = self.env.unwrapped.action_masks()
+        return self.model.predict(
+            observation, state, episode_start, deterministic, action_masks=masks
+        )
 
 
 def model_path(path: Path) -> Path:
@@ -131,7 +153,10 @@ def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
         check_single_agent_view(venv, env, env_id)
         return SharedPolicyPredictor(_normalized(model, file, venv), venv.n_agents)
     _check_spaces(model, env, file, f"the {env_id} environment")
-    return _normalized(model, file, DummyVecEnv([lambda: env]))
+    predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
+    if isinstance(model, MaskablePPO):
+        return MaskedModel(predictor, env)
+    return predictor
 
 
 def available_policies(env_id: str) -> list[str]:

@@ -159,6 +159,10 @@ def train(
     venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
     eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
     eval_venv = _normalize(eval_venv, config, False)
+    if algo == "maskableppo" and not venv.has_attr("action_masks"):
+        raise UsageError(
+            f"{env_id} with vec_env {config['vec_env']} gives no action masks for maskableppo"
+        )
     algorithm = algorithm_classes()[algo]
     model = algorithm(
         config["policy"],

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from motiongym.agents.environments import make_env
+from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import evaluate
 from motiongym.agents.predictors import load_predictor
 from motiongym.agents.train import train
@@ -18,6 +19,7 @@ FAMILIES = {
     "td3": ("motiongym/DualArmCell-v0", "  learning_starts: 16\n  batch_size: 16\n"),
     "dqn": ("motiongym/Sweeper-v0", "  learning_starts: 16\n  batch_size: 16\n"),
     "recurrentppo": ("motiongym/ExcavatorReach-v0", "  n_steps: 32\n  batch_size: 32\n"),
+    "maskableppo": ("motiongym/Sweeper-v0", "  n_steps: 32\n  batch_size: 32\n"),
 }
 
 
@@ -39,3 +41,10 @@ def test_tiny_run_writes_a_model_that_evaluates(algo, tmp_path):
     predictor = load_predictor(str(run_dir), env_id, env)
     evaluation = evaluate(env, predictor, [7], env_id, algo, progress=False)
     assert 0 < evaluation.episodes[0]["length"] <= 40
+
+
+def test_maskableppo_needs_an_environment_with_action_masks(tmp_path):
+    config = tmp_path / "tiny.yml"
+    config.write_text("maskableppo:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_steps: 32\n")
+    with pytest.raises(UsageError, match="no action masks"):
+        train("motiongym/ExcavatorReach-v0", "maskableppo", config, out_root=tmp_path)
