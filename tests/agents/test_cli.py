@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from importlib import resources
@@ -94,8 +95,9 @@ def test_evaluate_writes_json_and_csv_with_the_env_measures(capsys, tmp_path):
 def test_every_shipped_config_block_is_valid():
     files = sorted(Path(str(resources.files("motiongym.configs"))).glob("*.yml"))
     assert files
-    for path in files:
-        assert f"motiongym/{path.stem}" in ENV_IDS, f"{path.name} names no registered ID"
+    for path in files:  # <Name>-vN.yml, or <Name>-vN-<variant>.yml
+        name = re.match(r".+?-v\d+", path.stem)
+        assert name and f"motiongym/{name.group(0)}" in ENV_IDS, f"{path.name}: no registered ID"
         for algo in yaml.safe_load(path.read_text()):
             config = load_config(path, algo)
             assert config["n_timesteps"] > 0
