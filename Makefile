@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 EPISODES ?= 10
 
-.PHONY: install demo test test-slow lint
+.PHONY: install demo test test-slow lint models benchmarks
 
 $(STAMP): pyproject.toml setup.py
 	python3 -m venv $(VENV)
@@ -30,3 +30,25 @@ test-slow: $(STAMP)
 lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+
+# The shipped models (agents/pretrained/): every ID's configs/<ID>.yml PPO block
+# and the dual-arm shared-parameter block, three training seeds each; `ship`
+# evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
+SEEDS ?= 0 1 2
+IDS ?= Sweeper-v0 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
+models: $(STAMP)
+	for id in $(IDS); do \
+	  for seed in $(SEEDS); do \
+	    $(BIN)/motiongym train motiongym/$$id --algo ppo --seed $$seed --out runs/models || exit 1; \
+	  done; \
+	  $(BIN)/motiongym ship runs/models/$$id/ppo_seed* || exit 1; \
+	done
+	for seed in $(SEEDS); do \
+	  $(BIN)/motiongym train motiongym/DualArmCell-v0 --algo ppo --seed $$seed \
+	    --config configs/DualArmCell-v0-shared.yml --out runs/models-shared || exit 1; \
+	done
+	$(BIN)/motiongym ship runs/models-shared/DualArmCell-v0/ppo_seed*
+
+# BENCHMARKS.md's tables and figures, from the shipped models' metrics.
+benchmarks: $(STAMP)
+	MUJOCO_GL=egl $(BIN)/motiongym benchmarks
