@@ -300,7 +300,7 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
                 links.append(math.hypot(plan, vertical) - r_link[k] - rp)
             bound = min(links)
         if bound < HORIZON:
-            self.pipe_clear = pipe_clearance(pts[:3], pts[1:], r_link, self.pipe, links)
+            self.pipe_clear = pipe_clearance(pts, r_link, self.pipe, links)
         else:
             self.pipe_clear = bound
         # Truck: first its circumscribed circle's lateral gap and the rim height.
@@ -319,15 +319,14 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
             amin, amax = min(along), max(along)
             if radial is None:
                 radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
-            links = []
+            bound = math.inf
             for k in range(3):
                 ra, rb = radial[k], radial[k + 1]
                 ahead = max(amin - max(ra, rb), min(ra, rb) - amax, 0.0)
                 above = min(heights[k], heights[k + 1]) - rim
-                links.append(max(side, ahead, above) - r_link[k])
-            bound = min(links)
+                bound = min(bound, max(side, ahead, above) - r_link[k])
         if bound < HORIZON:
-            self.truck_clear = truck_clearance(pts[:3], pts[1:], r_link, truck, links)
+            self.truck_clear = truck_clearance(pts, r_link, truck)
         else:
             self.truck_clear = bound
 

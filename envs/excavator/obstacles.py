@@ -7,18 +7,19 @@ stick (to the bucket pin) and bucket (pin to cutting edge), with the radii of
 
 * pipe: a capsule of radius ``r`` about a straight segment below the ground
   (a utility located by a locate survey); clearance = segment-segment
-  distance (:mod:`motiongym.envs.geometry`) - link radius - ``r``.
+  distance (:func:`segment_distance`, the formulas of
+  :mod:`motiongym.envs.geometry` for one pair) - link radius - ``r``.
 * truck: the body as a box (footprint ``length x width`` turned by ``yaw``,
   from the ground up to the rim height; the open bed is inside it, so a bucket
   must stay above the rim). The segment-box distance is exact, computed in
-  the box's frame by :func:`segment_box_distance` (scalar math: the arm has
-  three links, where NumPy's per-call overhead would dominate).
+  the box's frame by :func:`segment_box_distance`.
 
-Broad phase: an environment step first takes cheap lower bounds (the pipe is
-below the arm's lowest point, a capsule's bounding sphere against the box) and
-runs the exact computation only when a bound is under ``horizon``; beyond it
-the reported clearance is that lower bound (it is then larger than
-``horizon``, 1 m, which is larger than every safety distance).
+Both are scalar math: the arm has three links, where NumPy's per-call
+overhead would dominate. Broad phase: an environment step first takes cheap
+lower bounds (:meth:`ExcavatorBase._clearances`) and runs the exact
+computation only when a bound is under ``horizon``; beyond it the reported
+clearance is that lower bound (it is then larger than ``horizon``, 1 m,
+which is larger than every safety distance).
 """
 
 from __future__ import annotations
@@ -131,29 +132,27 @@ def segment_distance(
     return math.sqrt(x * x + y * y + z * z)
 
 
-def _visiting_order(n: int, lower_bounds: Sequence[float] | None) -> Sequence[int]:
-    """Capsule indices, from the smallest lower bound up when bounds are given."""
-    if lower_bounds is None:
-        return range(n)
-    return sorted(range(n), key=lower_bounds.__getitem__)
-
-
 def pipe_clearance(
-    starts: Sequence[Sequence[float]],
-    ends: Sequence[Sequence[float]],
+    points: Sequence[Sequence[float]],
     radii: Sequence[float],
     pipe: Pipe,
     lower_bounds: Sequence[float] | None = None,
 ) -> float:
-    """Exact clearance of the capsules ``starts[k] -> ends[k]`` (frame M) to the pipe (m).
+    """Exact clearance of a chain of capsules (as in :func:`truck_clearance`) to the pipe (m).
 
-    ``lower_bounds`` as in :func:`truck_clearance`.
+    ``lower_bounds`` (optional, one per capsule) are lower bounds of each
+    capsule's clearance: the capsules are then visited from the smallest
+    bound up, and the visit stops at a bound not below the smallest clearance
+    so far, which leaves the minimum unchanged.
     """
+    order = range(len(radii))
+    if lower_bounds is not None:
+        order = sorted(order, key=lower_bounds.__getitem__)
     out = math.inf
-    for k in _visiting_order(len(radii), lower_bounds):
+    for k in order:
         if lower_bounds is not None and lower_bounds[k] >= out:
             break
-        d = segment_distance(starts[k], ends[k], pipe.a, pipe.b)
+        d = segment_distance(points[k], points[k + 1], pipe.a, pipe.b)
         out = min(out, d - radii[k] - pipe.radius)
     return float(out)
 
@@ -221,30 +220,37 @@ def segment_box_distance(
 
 
 def truck_clearance(
-    starts: Sequence[Sequence[float]],
-    ends: Sequence[Sequence[float]],
-    radii: Sequence[float],
-    truck: Truck,
-    lower_bounds: Sequence[float] | None = None,
+    points: Sequence[Sequence[float]], radii: Sequence[float], truck: Truck
 ) -> float:
-    """Exact clearance of the capsules ``starts[k] -> ends[k]`` (frame M) to the truck box (m).
+    """Exact clearance of a chain of capsules to the truck box (m).
 
-    ``lower_bounds`` (optional, one per capsule) are lower bounds of each
-    capsule's clearance: the capsules are visited from the smallest bound up,
-    and the visit stops at a bound not below the smallest clearance so far
+    Capsule ``k`` is about the segment ``points[k] -> points[k + 1]`` (frame
+    M) with radius ``radii[k]``, as the arm's links. In the box's frame, the
+    gap between a segment's bounding box and the truck box is a lower bound
+    of their distance (per axis, every point of the segment is at least that
+    far from the box's slab): the capsules are visited from the smallest bound
+    up, and the visit stops at a bound not below the smallest clearance so far
     (no later capsule can be closer), which leaves the minimum unchanged.
     """
     low, high = truck.box()
     c, s = math.cos(truck.yaw), math.sin(truck.yaw)
-
-    def to_box(p: Sequence[float]) -> tuple[float, float, float]:
+    local = []  # the points in the box's frame: along, across, up
+    for p in points:
         dx, dy = p[0] - truck.cx, p[1] - truck.cy
-        return c * dx + s * dy, -s * dx + c * dy, p[2]
-
+        local.append((c * dx + s * dy, -s * dx + c * dy, p[2]))
+    bounds = []
+    for k, r in enumerate(radii):
+        a, b = local[k], local[k + 1]
+        gap = 0.0
+        for i in range(3):
+            lo, hi = (a[i], b[i]) if a[i] <= b[i] else (b[i], a[i])
+            g = low[i] - hi if hi < low[i] else lo - high[i] if lo > high[i] else 0.0
+            gap += g * g
+        bounds.append(math.sqrt(gap) - r)
     out = math.inf
-    for k in _visiting_order(len(radii), lower_bounds):
-        if lower_bounds is not None and lower_bounds[k] >= out:
+    for k in sorted(range(len(radii)), key=bounds.__getitem__):
+        if bounds[k] >= out:
             break
-        d = segment_box_distance(to_box(starts[k]), to_box(ends[k]), low, high) - radii[k]
-        out = min(out, d)
+        d = segment_box_distance(local[k], local[k + 1], low, high)
+        out = min(out, d - radii[k])
     return float(out)

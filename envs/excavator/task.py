@@ -177,8 +177,7 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine) -> Scene:
             continue
         if any(p[2] < heights[ix(p[0]), iy(p[1])] + 0.3 for p in pts[1:3]):
             continue
-        starts, ends = np.array(pts[:3]), np.array(pts[1:])
-        if truck_clearance(starts, ends, np.array(m.link_radius), truck) < 1.0:
+        if truck_clearance(pts, m.link_radius, truck) < 1.0:
             continue
         break
     else:  # pragma: no cover - the acceptance rate is about 5 %

@@ -96,10 +96,8 @@ def test_reported_clearances_are_exact_near_and_lower_bounds_far():
             env.q = list(rng.uniform(m.q_min, m.q_max))
             env._forward()
             env._clearances()
-            starts, ends = np.array(env.points[:3]), np.array(env.points[1:])
-            radii = np.array(m.link_radius)
-            pipe = pipe_clearance(starts, ends, radii, env.pipe)
-            truck = truck_clearance(starts, ends, radii, env.truck)
+            pipe = pipe_clearance(env.points, m.link_radius, env.pipe)
+            truck = truck_clearance(env.points, m.link_radius, env.truck)
             for got, exact in ((env.pipe_clear, pipe), (env.truck_clear, truck)):
                 if exact < base.HORIZON:
                     assert got == pytest.approx(exact, abs=1e-9)

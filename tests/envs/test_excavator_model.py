@@ -194,20 +194,19 @@ def _dense(p0, p1, q0, q1, n=400):
 
 def test_pipe_clearance_known_case():
     pipe = Pipe(a=(0.0, -5.0, -2.0), b=(0.0, 5.0, -2.0), radius=0.15)
-    starts = np.array([[-1.0, 0.0, 0.0]])
-    ends = np.array([[1.0, 0.0, -1.0]])
+    link = [(-1.0, 0.0, 0.0), (1.0, 0.0, -1.0)]
     # Closest at x = 0.6 on the segment: distance sqrt(0.6^2 + 1.2^2) to the pipe's axis.
-    assert pipe_clearance(starts, ends, np.array([0.45]), pipe) == pytest.approx(
+    assert pipe_clearance(link, [0.45], pipe) == pytest.approx(
         math.sqrt(1.8) - 0.45 - 0.15, abs=1e-9
     )
 
 
 def test_truck_clearance_known_cases_and_dense_sampling():
     truck = Truck(cx=0.0, cy=6.0, yaw=0.3, half_length=2.5, half_width=1.2, height=2.8)
-    r = np.array([0.0])
-    above = truck_clearance(np.array([[0.0, 6.0, 4.0]]), np.array([[0.5, 6.2, 4.5]]), r, truck)
+    r = [0.0]
+    above = truck_clearance([(0.0, 6.0, 4.0), (0.5, 6.2, 4.5)], r, truck)
     assert above == pytest.approx(1.2)
-    through = truck_clearance(np.array([[0.0, 6.0, 5.0]]), np.array([[0.0, 6.0, -1.0]]), r, truck)
+    through = truck_clearance([(0.0, 6.0, 5.0), (0.0, 6.0, -1.0)], r, truck)
     assert through == 0.0
     rng = np.random.default_rng(4)
     g = np.stack(
@@ -222,7 +221,7 @@ def test_truck_clearance_known_cases_and_dense_sampling():
     )
     for _ in range(20):
         p0, p1 = rng.uniform([-6, 0, 0], [6, 12, 6], size=(2, 3))
-        exact = truck_clearance(p0[None], p1[None], r, truck)
+        exact = truck_clearance([p0, p1], r, truck)
         s = np.linspace(0, 1, 300)[:, None]
         seg = p0 + s * (p1 - p0)
         sampled = np.min(np.linalg.norm(seg[:, None] - box_pts[None], axis=-1))
@@ -284,18 +283,15 @@ def test_segment_box_distance_known_cases():
     assert segment_box_distance((-1.0, -1.0, -1.0), (3.0, 2.0, 2.0), low, high) == 0.0
 
 
-def test_truck_clearance_bounds_only_skip_capsules_that_cannot_be_closest():
+def test_truck_clearance_of_a_chain_is_its_closest_capsules():
     rng = np.random.default_rng(12)
     truck = Truck(cx=1.0, cy=6.0, yaw=-0.4, half_length=2.5, half_width=1.2, height=2.8)
     radii = [0.35, 0.25, 0.45]
-    for _ in range(200):
+    for _ in range(300):
         pts = [tuple(p) for p in rng.uniform([-6, 0, -1], [6, 12, 6], size=(4, 3))]
         links = zip(pts[:3], pts[1:], radii, strict=True)
-        each = [truck_clearance([a], [b], [r], truck) for a, b, r in links]
-        slack = rng.uniform(0.0, 2.0, 3)  # any lower bounds: the exact values less some slack
-        bounds = [e - s for e, s in zip(each, slack, strict=True)]
-        assert truck_clearance(pts[:3], pts[1:], radii, truck) == min(each)
-        assert truck_clearance(pts[:3], pts[1:], radii, truck, bounds) == min(each)
+        each = [truck_clearance([a, b], [r], truck) for a, b, r in links]
+        assert truck_clearance(pts, radii, truck) == pytest.approx(min(each), abs=1e-12)
 
 
 def test_segment_distance_equals_the_shared_routine():
@@ -320,7 +316,7 @@ def test_pipe_clearance_bounds_only_skip_capsules_that_cannot_be_closest():
     for _ in range(200):
         pts = [tuple(p) for p in rng.uniform([-6, -6, -3], [6, 6, 3], size=(4, 3))]
         links = zip(pts[:3], pts[1:], radii, strict=True)
-        each = [pipe_clearance([a], [b], [r], pipe) for a, b, r in links]
+        each = [pipe_clearance([a, b], [r], pipe) for a, b, r in links]
         bounds = [e - s for e, s in zip(each, rng.uniform(0.0, 2.0, 3), strict=True)]
-        assert pipe_clearance(pts[:3], pts[1:], radii, pipe) == min(each)
-        assert pipe_clearance(pts[:3], pts[1:], radii, pipe, bounds) == min(each)
+        assert pipe_clearance(pts, radii, pipe) == min(each)
+        assert pipe_clearance(pts, radii, pipe, bounds) == min(each)
