@@ -71,6 +71,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     slide_back = False  # shift further back along the lane when blocked at its end
     repush = True  # a popped segment goes back under the run it starts
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
+    restart_axis = True  # a popped run may turn its lanes across (psa.restart_heading)
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -271,9 +272,10 @@ class PsaCwaPolicy(ScriptedPolicy):
                 return None
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             return None
-        m.run_heading, m.run_side = psa.restart_heading(
-            self._stretches(m, r, c), m.run_heading, m.run_side, self.w
-        )
+        if self.restart_axis:
+            m.run_heading, m.run_side = psa.restart_heading(
+                self._stretches(m, r, c), m.run_heading, m.run_side, self.w
+            )
         m.mode, m.lane_start, m.first_lane = "lane", (r, c), True
         return None
 
