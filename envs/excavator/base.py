@@ -320,11 +320,19 @@ class ExcavatorBase(OwnsRenderer, gym.Env):
             if radial is None:
                 radial = [c1 * (p[0] - ox) + s1 * (p[1] - oy) for p in pts]
             bound = math.inf
+            # Comparisons, not min/max calls (this runs on many steps); side >= 0
+            # stands for the clamp of ``ahead`` at zero.
             for k in range(3):
-                ra, rb = radial[k], radial[k + 1]
-                ahead = max(amin - max(ra, rb), min(ra, rb) - amax, 0.0)
-                above = min(heights[k], heights[k + 1]) - rim
-                bound = min(bound, max(side, ahead, above) - r_link[k])
+                near, far = radial[k], radial[k + 1]
+                if near > far:
+                    near, far = far, near
+                ahead = amin - far if amin - far > near - amax else near - amax
+                za, zb = heights[k], heights[k + 1]
+                above = (za if za < zb else zb) - rim
+                gap = side if side > ahead else ahead
+                gap = (gap if gap > above else above) - r_link[k]
+                if gap < bound:
+                    bound = gap
         if bound < HORIZON:
             self.truck_clear = truck_clearance(pts, r_link, truck)
         else:
