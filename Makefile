@@ -31,7 +31,7 @@ lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
-# The shipped models (agents/pretrained/): every ID's configs/<ID>.yml PPO block
+# The shipped models (agents/pretrained/): every ID's configs/<ID>.yml first block
 # and the dual-arm shared-parameter block, three training seeds each; `ship`
 # evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
 SEEDS ?= 0 1 2
@@ -39,12 +39,12 @@ IDS ?= Sweeper-v0 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReac
 models: $(STAMP)
 	for id in $(IDS); do \
 	  for seed in $(SEEDS); do \
-	    $(BIN)/motiongym train motiongym/$$id --algo ppo --seed $$seed --out runs/models || exit 1; \
+	    $(BIN)/motiongym train motiongym/$$id --seed $$seed --out runs/models || exit 1; \
 	  done; \
-	  $(BIN)/motiongym ship runs/models/$$id/ppo_seed* || exit 1; \
+	  $(BIN)/motiongym ship runs/models/$$id/*_seed* || exit 1; \
 	done
 	for seed in $(SEEDS); do \
-	  $(BIN)/motiongym train motiongym/DualArmCell-v0 --algo ppo --seed $$seed \
+	  $(BIN)/motiongym train motiongym/DualArmCell-v0 --seed $$seed \
 	    --config configs/DualArmCell-v0-shared.yml --out runs/models-shared || exit 1; \
 	done
 	$(BIN)/motiongym ship runs/models-shared/DualArmCell-v0/ppo_seed*

@@ -196,7 +196,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     train = commands.add_parser("train", help="train an SB3 algorithm from configs/")
     train.add_argument("env_id", help="environment ID")
-    train.add_argument("--algo", default="ppo", choices=sorted(algorithm_classes()))
+    train.add_argument(
+        "--algo",
+        choices=sorted(algorithm_classes()),
+        help="an algorithm block of the config (default: its first, the tuned one)",
+    )
     train.add_argument("--config", type=Path, help="YAML file (default: configs/<Name>-vN.yml)")
     train.add_argument("--seed", type=int, default=0)
     train.add_argument("--timesteps", type=int, help="override the config's n_timesteps")

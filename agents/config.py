@@ -1,7 +1,8 @@
 """Training configurations: YAML in ``configs/``, one file per environment ID.
 
 A file ``configs/<Name>-vN.yml`` (rl-baselines3-zoo style) holds one block
-per algorithm (``ppo``, ``sac``, ``maskableppo``, ...). A block's keys are
+per algorithm (``ppo``, ``sac``, ``maskableppo``, ...); the first block is
+the tuned choice, which ``motiongym train`` trains unless told another. A block's keys are
 either the run settings below or keyword arguments of the algorithm's
 constructor (``learning_rate``, ``n_steps``, ...); any other key is rejected
 with its name. ``policy_kwargs`` is a mapping, never code: the activation
@@ -77,8 +78,8 @@ def default_config_path(env_id: str) -> Path:
     return Path(str(resources.files("motiongym.configs") / f"{short_name(env_id)}.yml"))
 
 
-def load_config(path: Path, algo: str) -> dict[str, Any]:
-    """The validated block ``algo`` of the YAML file at ``path``, defaults filled in."""
+def _document(path: Path) -> dict[str, Any]:
+    """The YAML file at ``path`` as ``{algorithm: block}``, or a named error."""
     if not path.is_file():
         raise UsageError(f"no configuration file at {path}")
     try:
@@ -86,8 +87,19 @@ def load_config(path: Path, algo: str) -> dict[str, Any]:
     except yaml.YAMLError as error:
         problem = " ".join(str(error).split())
         raise UsageError(f"malformed YAML in {path}: {problem}") from error
-    if not isinstance(document, dict):
+    if not isinstance(document, dict) or not document:
         raise UsageError(f"{path} must map algorithm names to blocks of settings")
+    return document
+
+
+def first_block(path: Path) -> str:
+    """The algorithm of the file's first block: the tuned choice, trained by default."""
+    return next(iter(_document(path)))
+
+
+def load_config(path: Path, algo: str) -> dict[str, Any]:
+    """The validated block ``algo`` of the YAML file at ``path``, defaults filled in."""
+    document = _document(path)
     if algo not in document:
         raise UsageError(
             f"{path} has no block for algorithm {algo!r}; blocks: {', '.join(document)}"

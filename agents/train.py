@@ -46,6 +46,7 @@ from motiongym.agents.config import (
     ACTIVATIONS,
     algorithm_kwargs,
     default_config_path,
+    first_block,
     load_config,
 )
 from motiongym.agents.environments import check_env_id, importable_id, short_name
@@ -135,16 +136,17 @@ def learning_curve_figure(evaluations_file: Path, path: Path, title: str) -> Pat
 
 def train(
     env_id: str,
-    algo: str,
+    algo: str | None = None,
     config_path: Path | None = None,
     seed: int = 0,
     out_root: Path = Path("runs"),
     n_timesteps: int | None = None,
     progress: bool = True,
 ) -> Path:
-    """Train ``algo`` on ``env_id`` as its configuration says; return the run folder."""
+    """Train ``algo`` (default: the file's first block) on ``env_id``; return the run folder."""
     check_env_id(env_id)
     config_path = config_path or default_config_path(env_id)
+    algo = algo or first_block(config_path)
     config = load_config(config_path, algo)
     if n_timesteps is not None:
         config["n_timesteps"] = n_timesteps

@@ -13,7 +13,8 @@ import pytest
 import yaml
 
 from motiongym.agents.cli import main
-from motiongym.agents.config import load_config
+from motiongym.agents.config import default_config_path, load_config
+from motiongym.agents.train import train
 from motiongym.baselines import scripted_policies
 from motiongym.envs import ENV_IDS
 
@@ -178,3 +179,17 @@ def test_every_subcommand_has_help(argv, capsys):
         main([*argv, "--help"])
     assert exit_info.value.code == 0
     assert "usage: motiongym" in capsys.readouterr().out
+
+
+def test_train_defaults_to_the_config_files_first_block(tmp_path):
+    from motiongym.agents.config import first_block
+
+    config = tmp_path / "two.yml"
+    config.write_text(
+        "a2c:\n  n_timesteps: 16\n  policy: MlpPolicy\n  n_steps: 8\n"
+        "ppo:\n  n_timesteps: 16\n  policy: MlpPolicy\n"
+    )
+    assert first_block(config) == "a2c"
+    run_dir = train("motiongym/ExcavatorReach-v0", config_path=config, out_root=tmp_path)
+    assert run_dir.name.startswith("a2c_seed0_")
+    assert first_block(default_config_path("motiongym/Sweeper-v0")) == "maskableppo"
