@@ -166,16 +166,19 @@ def train(
             f"{env_id} with vec_env {config['vec_env']} gives no action masks for maskableppo"
         )
     algorithm = algorithm_classes()[algo]
-    model = algorithm(
-        config["policy"],
-        venv,
-        policy_kwargs=policy_kwargs(config),
-        tensorboard_log=str(run_dir / "tb"),
-        seed=seed,
-        device="cpu",
-        verbose=0,
-        **algorithm_kwargs(config),
-    )
+    try:
+        model = algorithm(
+            config["policy"],
+            venv,
+            policy_kwargs=policy_kwargs(config),
+            tensorboard_log=str(run_dir / "tb"),
+            seed=seed,
+            device="cpu",
+            verbose=0,
+            **algorithm_kwargs(config),
+        )
+    except AssertionError as error:  # SB3 checks the spaces with assertions
+        raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
     eval_dir = run_dir / "eval"
     if algo == "maskableppo":
         from sb3_contrib.common.maskable.callbacks import MaskableEvalCallback as EvalCallbackClass

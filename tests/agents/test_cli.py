@@ -68,8 +68,10 @@ def test_config_errors_name_the_key(capsys, tmp_path):
     no_block = tmp_path / "sac_only.yml"
     no_block.write_text("sac:\n  n_timesteps: 10\n  policy: MlpPolicy\n")
     assert "no block for algorithm 'ppo'" in _error(
-        capsys, ["train", SWEEPER, "--config", str(no_block)]
+        capsys, ["train", SWEEPER, "--algo", "ppo", "--config", str(no_block)]
     )
+    err = _error(capsys, ["train", SWEEPER, "--config", str(no_block), "--out", str(tmp_path)])
+    assert "sac cannot train on motiongym/Sweeper-v0" in err and "Discrete(3)" in err
 
 
 def test_evaluate_writes_json_and_csv_with_the_env_measures(capsys, tmp_path):
