@@ -54,6 +54,7 @@ class Memory:
     lane_start: tuple[int, int] | None = None
     first_lane: bool = True  # no shift yet in this run (its side may still flip)
     run: int = 0  # number of the current PSA run (stack entries carry the run that pushed them)
+    retry: bool = False  # a transfer was aborted: take the stack's top entry next
     stack: psa.PsaStack = field(default_factory=psa.PsaStack)
     cwa_stack: list = field(default_factory=list)
     cwa_cells: np.ndarray | None = None
@@ -221,7 +222,10 @@ class PsaCwaPolicy(ScriptedPolicy):
         LIFO by runs: the candidates are the entries the latest run on the
         stack pushed, and of those the one whose restart point is nearest
         (:mod:`.psa`'s docstring); a group with no work left is dropped (the
-        paper's skip). The ``nearest`` ablation considers every entry.
+        paper's skip). After an aborted transfer (its goal found blocked, as
+        under odometry error) only the top entry, the one re-pushed, is a
+        candidate: choosing the nearest again could swing between two
+        entries for ever. The ``nearest`` ablation considers every entry.
         """
         origin, occ, swept, cfree, cur = self._known(m, r, c)
         dist = world.bfs_distance(cfree, cur)
@@ -234,8 +238,14 @@ class PsaCwaPolicy(ScriptedPolicy):
                     return found
             return None
 
+        retry, m.retry = m.retry, False
         while len(m.stack):
-            group = range(len(m.stack)) if self.pop_order == "nearest" else m.stack.top_run()
+            if retry:  # the entry of an aborted transfer, re-pushed on top
+                group, retry = [len(m.stack) - 1], False
+            elif self.pop_order == "nearest":
+                group = range(len(m.stack))
+            else:
+                group = m.stack.top_run()
             found = {k: t for k in group if (t := restart(m.stack.items[k])) is not None}
             if not found:
                 for k in reversed(group):
@@ -267,8 +277,8 @@ class PsaCwaPolicy(ScriptedPolicy):
             goal = (m.goal[0] - origin[0], m.goal[1] - origin[1])
             ok = 0 <= goal[0] < cfree.shape[0] and 0 <= goal[1] < cfree.shape[1]
             path = quadtree.plan(cfree, cur, goal) if ok and cfree[goal] else None
-            if path is None:
-                m.mode = "pop"
+            if path is None:  # the goal turned out blocked: its entry is retried first
+                m.mode, m.retry = "pop", True
                 return None
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             return None

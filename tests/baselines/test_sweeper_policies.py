@@ -98,3 +98,34 @@ def test_nearest_first_ablation_also_sweeps_everything() -> None:
     for map_name in ("apartment", "maze"):
         info = sweep(map_name, seed=0, policy="psa-cwa-nearest")
         assert info["is_success"]
+
+
+def _popping(entries: list[tuple[tuple[int, int], int]], retry: bool = False) -> tuple[int, int]:
+    """Where PSA + CWA transfers to from (8, 10) in an empty room, given stack entries
+    ``(segment start, run)`` (segments heading east, 3 long, bottom to top)."""
+    from motiongym.baselines.sweeper import psa
+    from motiongym.baselines.sweeper.psa_cwa import PsaCwaPolicy
+
+    env = gym.make(ENV_ID, grid=empty_room(20, 26))
+    policy = PsaCwaPolicy(env.observation_space, env.action_space, {})
+    obs, _ = env.reset(seed=0, options={"start": (8, 10), "heading": 0})
+    memory = policy.new_memory()
+    policy.act(obs, memory)  # writes the first window into the robot's maps
+    memory.stack = psa.PsaStack()
+    for start, run in entries:
+        memory.stack.push(psa.Segment(start, 0, 3, 3), run)
+    memory.retry = retry
+    policy._pop(memory, 8, 10, 0)
+    assert memory.mode == "transfer"
+    return memory.goal
+
+
+def test_pop_takes_the_nearest_entry_of_the_latest_run() -> None:
+    near, far = ((8, 14), 1), ((13, 4), 1)
+    assert _popping([near, far]) == (8, 14)  # the top entry is farther: LIFO by runs
+    assert _popping([(near[0], 0), (far[0], 1)]) == (13, 6)  # an older run waits (nearer end)
+
+
+def test_pop_after_an_aborted_transfer_retries_the_top_entry() -> None:
+    near, far = ((8, 14), 1), ((13, 4), 1)
+    assert _popping([near, far], retry=True) == (13, 6)
