@@ -24,6 +24,13 @@ from motiongym.envs.excavator.obstacles import (  # noqa: E402
     truck_clearance,
 )
 from motiongym.envs.excavator.soil import Terrain, cutting_force, speed_fraction  # noqa: E402
+from motiongym.envs.excavator.task import (  # noqa: E402
+    GRID_CELL,
+    GRID_ORIGIN,
+    GRID_SHAPE,
+    ZONE_MARGIN,
+    DigZone,
+)
 from motiongym.envs.geometry import closest_points_between_segments  # noqa: E402
 
 
@@ -320,3 +327,25 @@ def test_pipe_clearance_bounds_only_skip_capsules_that_cannot_be_closest():
         bounds = [e - s for e, s in zip(each, rng.uniform(0.0, 2.0, 3), strict=True)]
         assert pipe_clearance(pts, radii, pipe) == min(each)
         assert pipe_clearance(pts, radii, pipe, bounds) == min(each)
+
+
+def test_zone_mask_is_the_strip_test_over_every_cell():
+    rng = np.random.default_rng(15)
+    xs = GRID_ORIGIN[0] + (np.arange(GRID_SHAPE[0]) + 0.5) * GRID_CELL
+    ys = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL
+    sizes = []
+    for _ in range(40):  # some reach past the map's edge (11 m)
+        zone = DigZone(rng.uniform(-math.pi, math.pi), rng.uniform(-2.0, 8.0), 0.0, 0.7)
+        zone = DigZone(zone.azimuth, zone.r_near, zone.r_near + rng.uniform(1.0, 7.0), 0.7)
+        half = rng.uniform(0.3, 1.0)
+        c, s = math.cos(zone.azimuth), math.sin(zone.azimuth)
+        along = c * xs[:, None] + s * ys[None, :]
+        across = -s * xs[:, None] + c * ys[None, :]
+        want = (
+            (along >= zone.r_near - ZONE_MARGIN)
+            & (along <= zone.r_far + ZONE_MARGIN)
+            & (np.abs(across) <= half + ZONE_MARGIN)
+        )
+        np.testing.assert_array_equal(zone.mask(half), want)
+        sizes.append(want.sum())
+    assert min(sizes) > 0
