@@ -90,11 +90,8 @@ class Truck:
 
     def box(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """The box in its own frame (along, across, up): ``(low, high)`` corners (m)."""
-        return (-self.half_length, -self.half_width, 0.0), (
-            self.half_length,
-            self.half_width,
-            self.height,
-        )
+        hl, hw = self.half_length, self.half_width
+        return (-hl, -hw, 0.0), (hl, hw, self.height)
 
 
 def segment_distance(
