@@ -141,6 +141,26 @@ def covers_unswept(occ: np.ndarray, swept: np.ndarray, w: int, at_least: int = 1
     return box_sum(todo.astype(np.int64), w) >= at_least
 
 
+def entering_gains(todo: np.ndarray, w: int) -> np.ndarray:
+    """``(4, H, W)`` int: ``todo`` cells entering the footprint when the robot moves
+    into configuration ``(r, c)`` in heading ``k`` (0 E, 1 N, 2 W, 3 S)."""
+    h, wd = todo.shape
+    pad = np.zeros((h + w, wd + w), np.int64)
+    pad[:h, :wd] = todo
+    col = np.zeros((h + 1, wd + w), np.int64)  # col[r, c]: todo in pad[r : r + w, c]
+    row = np.zeros((h + w, wd + 1), np.int64)  # row[r, c]: todo in pad[r, c : c + w]
+    cs = np.vstack([np.zeros((1, wd + w), np.int64), pad.cumsum(0)])
+    col[:, :] = cs[w : w + h + 1] - cs[: h + 1]
+    rs = np.hstack([np.zeros((h + w, 1), np.int64), pad.cumsum(1)])
+    row[:, :] = rs[:, w : w + wd + 1] - rs[:, : wd + 1]
+    out = np.empty((4, h, wd), np.int64)
+    out[0] = col[:h, w - 1 : w - 1 + wd]  # east: the column at c + w - 1
+    out[1] = row[:h, :wd]  # north: the row r
+    out[2] = col[:h, :wd]  # west: the column c
+    out[3] = row[w - 1 : w - 1 + h, :wd]  # south: the row r + w - 1
+    return out
+
+
 def first_target(
     seg: Segment,
     origin: tuple[int, int],

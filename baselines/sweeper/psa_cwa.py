@@ -130,6 +130,11 @@ class PsaCwaPolicy(ScriptedPolicy):
         cfree[cur] = True  # the robot stands there, whatever the map says
         return (r0, c0), occ, swept, cfree, cur
 
+    def _plan(self, occ, swept, cfree, cur, goal) -> list[tuple[int, int]] | None:
+        """Quadtree transfer (:mod:`.quadtree`) sweeping the most unswept cells on its way."""
+        gains = psa.entering_gains((~swept) & (occ != OBSTACLE), self.w)
+        return quadtree.plan(cfree, cur, goal, gains)
+
     # -------------------------------------------------------------- PSA modes
     def _lane(self, m: Memory, r: int, c: int, h: int) -> int | None:
         if h != m.run_heading:
@@ -257,7 +262,8 @@ class PsaCwaPolicy(ScriptedPolicy):
             )
             seg, run = m.stack.pop(k)
             target, heading = found[k]
-            path = quadtree.plan(cfree, cur, (target[0] - origin[0], target[1] - origin[1]))
+            goal = (target[0] - origin[0], target[1] - origin[1])
+            path = self._plan(occ, swept, cfree, cur, goal)
             if path is None:  # pragma: no cover - BFS reached it, the quadtree must too
                 continue
             if self.repush:
@@ -273,10 +279,10 @@ class PsaCwaPolicy(ScriptedPolicy):
 
     def _transfer(self, m: Memory, r: int, c: int, h: int) -> int | None:
         if (r, c) != m.goal:  # the path was blocked: plan again
-            origin, _, _, cfree, cur = self._known(m, r, c)
+            origin, occ, swept, cfree, cur = self._known(m, r, c)
             goal = (m.goal[0] - origin[0], m.goal[1] - origin[1])
             ok = 0 <= goal[0] < cfree.shape[0] and 0 <= goal[1] < cfree.shape[1]
-            path = quadtree.plan(cfree, cur, goal) if ok and cfree[goal] else None
+            path = self._plan(occ, swept, cfree, cur, goal) if ok and cfree[goal] else None
             if path is None:  # the goal turned out blocked: its entry is retried first
                 m.mode, m.retry = "pop", True
                 return None
@@ -306,7 +312,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         m.cwa_last = state
         wide = (world.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
         if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
-            return self._restart_psa(m, r, c, origin, cfree, cur, wide, targets)
+            return self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
         m.cwa_stack = [
             ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
             for s, cells in cwa.scan_groups(targets, occ == OBSTACLE, self.w)
@@ -314,7 +320,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         m.mode = "cwa_pop"
         return None
 
-    def _restart_psa(self, m: Memory, r, c, origin, cfree, cur, wide, targets) -> None:
+    def _restart_psa(self, m: Memory, r, c, origin, occ, swept, cfree, cur, wide, targets) -> None:
         """Transfer to the nearest wide leftover and sweep it with a new PSA run.
 
         The run heads along the longest stretch of leftover configurations
@@ -328,7 +334,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         stretch = psa.stretches(todo, target)
         heading = max(range(4), key=lambda k: stretch[k])
         side = max((psa.left_of(heading), psa.right_of(heading)), key=lambda k: stretch[k])
-        path = quadtree.plan(cfree, cur, target)
+        path = self._plan(occ, swept, cfree, cur, target)
         m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
         m.goal = (target[0] + origin[0], target[1] + origin[1])
         m.run_heading, m.run_side, m.mode = heading, side, "transfer"
@@ -361,14 +367,14 @@ class PsaCwaPolicy(ScriptedPolicy):
             cells = self._remaining(m, cells)
             if not len(cells):
                 continue
-            origin, _, _, cfree, cur = self._known(m, r, c)
+            origin, occ, swept, cfree, cur = self._known(m, r, c)
             dist = world.bfs_distance(cfree, cur)
             first = self._remaining(m, np.array([seed]))
             aim = first if len(first) else cells
             target = cwa.nearest_cover(dist, aim - np.array(origin), self.w)
             if target is None:
                 continue
-            path = quadtree.plan(cfree, cur, target)
+            path = self._plan(occ, swept, cfree, cur, target)
             if path is None:  # pragma: no cover - BFS found it, the quadtree must too
                 continue
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)

@@ -14,6 +14,19 @@ robot, as in the paper's bitmap simulation). The chain of squares is turned
 into cell moves: inside a free square any monotone (L-shaped) path between
 two of its cells stays in it, so the path goes from the current cell to the
 exit cell facing the next square, steps across, and so on to the goal.
+
+Our choice where the paper is silent (it takes the decomposition for its
+completeness and low cost; the path is a means): the policy moves along a
+shortest path over the known free configurations, and of those, one that
+sweeps the most cells not yet swept on its way (:func:`best_path`, gains
+from :func:`.psa.entering_gains`): a transfer that passes along a leftover
+strip sweeps it, where an L-shaped path might miss it and leave it to a
+later transfer. The quadtree's chain still decides whether a path exists.
+Restricted to the chain's squares the choice gained nothing measurable; over
+all free cells, mean travel ratio over 40 room starts 1.334 -> 1.326 (below
+SmartDFS's from 37 -> 38 starts), over procedural maps 2000-2059
+1.378 -> 1.353 (43 -> 48 below), the maze unchanged (1.486 -> 1.484 over
+40 starts).
 """
 
 from __future__ import annotations
@@ -21,6 +34,9 @@ from __future__ import annotations
 import heapq
 
 import numpy as np
+
+from motiongym.envs.sweeper import world
+from motiongym.envs.sweeper.world import DC, DR
 
 
 def decompose(free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -120,14 +136,63 @@ def _l_path(p: tuple[int, int], q: tuple[int, int]) -> list[tuple[int, int]]:
     return out
 
 
+def best_path(
+    corridor: np.ndarray, start: tuple[int, int], goal: tuple[int, int], gains: np.ndarray
+) -> list[tuple[int, int]]:
+    """Of the shortest 4-connected paths over ``corridor``, one of greatest total gain.
+
+    ``gains``: ``(4, H, W)``, what entering cell ``(r, c)`` by a move in
+    heading ``k`` (0 E, 1 N, 2 W, 3 S) is worth. Dynamic programming over
+    the distance layers of the cells that lie on a shortest path. Returns
+    the cells from ``start`` (excluded) to ``goal``; ``goal`` must be reachable.
+    """
+    ds = world.bfs_distance(corridor, start)
+    dg = world.bfs_distance(corridor, goal)
+    n = int(ds[goal])
+    on = (ds >= 0) & (dg >= 0) & (ds + dg == n)
+    value = np.full(corridor.shape, -1, np.int64)
+    value[start] = 0
+    came = np.zeros(corridor.shape, np.int64)  # heading of the move into each cell
+    h, w = corridor.shape
+    for d in range(1, n + 1):
+        layer = on & (ds == d)
+        for k in range(4):
+            dr, dc = int(DR[k]), int(DC[k])
+            prev = np.full(corridor.shape, -1, np.int64)  # value of the cell one move back
+            prev[max(dr, 0) : h + min(dr, 0), max(dc, 0) : w + min(dc, 0)] = value[
+                max(-dr, 0) : h + min(-dr, 0), max(-dc, 0) : w + min(-dc, 0)
+            ]
+            cand = np.where(layer & (prev >= 0), prev + gains[k], -1)
+            better = cand > value
+            value[better] = cand[better]
+            came[better] = k
+    path = [goal]
+    while path[-1] != start:
+        r, c = path[-1]
+        k = int(came[r, c])
+        path.append((r - int(DR[k]), c - int(DC[k])))
+    return path[-2::-1]
+
+
 def plan(
-    free: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
+    free: np.ndarray,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    gains: np.ndarray | None = None,
 ) -> list[tuple[int, int]] | None:
-    """Cells from ``start`` (excluded) to ``goal`` over ``free`` (4-connected), or None."""
+    """Cells from ``start`` (excluded) to ``goal`` over ``free`` (4-connected), or None.
+
+    Without ``gains``: L-shaped moves square by square along the chain. With
+    ``gains`` (see :func:`best_path`): the chain decides that a path exists,
+    and the path is, of the shortest ones over ``free``, one of greatest gain
+    (never longer than the former).
+    """
     leaves, label = decompose(free)
     chain = leaf_chain(leaves, label, start, goal)
     if chain is None:
         return None
+    if gains is not None:
+        return best_path(free, start, goal, gains)
     path: list[tuple[int, int]] = []
     p = start
     for u, v in zip(chain[:-1], chain[1:], strict=True):

@@ -44,6 +44,35 @@ def test_quadtree_path_valid_complete_and_near_shortest(name: str) -> None:
     assert total_q <= 1.1 * total_bfs
 
 
+def test_best_path_is_shortest_and_sweeps_the_leftover_strip() -> None:
+    grid = generator.empty_room(12, 12)
+    free = world.config_free(grid, 3)
+    todo = np.zeros(grid.shape, bool)
+    todo[1, 8:11] = True  # a leftover strip along the north wall, to the east
+    gains = psa.entering_gains(todo, 3)
+
+    def swept_on_the_way(path: list[tuple[int, int]]) -> int:
+        moves = zip([(1, 1), *path[:-1]], path, strict=True)
+        k = {(0, 1): 0, (-1, 0): 1, (0, -1): 2, (1, 0): 3}
+        return sum(gains[k[(b[0] - a[0], b[1] - a[1])]][b] for a, b in moves)
+
+    best = quadtree.plan(free, (1, 1), (8, 8), gains)
+    plain = quadtree.plan(free, (1, 1), (8, 8))
+    assert len(best) == len(plain) == 14  # 7 + 7 moves: as short as any
+    assert best[6] == (1, 8)  # east first, along the strip, then south
+    assert swept_on_the_way(best) == 3 and swept_on_the_way(plain) == 0
+    assert quadtree.plan(free, (1, 1), (1, 1), gains) == []
+
+
+def test_entering_gains_count_the_cells_a_move_sweeps() -> None:
+    todo = np.zeros((6, 6), bool)
+    todo[2, 1:4] = True
+    gains = psa.entering_gains(todo, 3)
+    assert gains[3, 0, 1] == 3  # moving south into (0, 1): row 2 enters, 3 cells
+    assert gains[0, 2, 1] == 1  # moving east into (2, 1): column 3 enters, 1 cell
+    assert gains[1, 2, 1] == 3 and gains[2, 2, 1] == 1
+
+
 def test_quadtree_no_path_between_separate_rooms() -> None:
     grid = generator.empty_room(10, 21)
     grid[:, 10] = True
