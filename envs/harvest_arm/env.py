@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import gymnasium as gym
@@ -63,12 +62,12 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
     name): ``progress`` * decrease of the gripper-fruit distance (m);
     ``- clearance`` * max(0, 1 - d_min / safety_distance); ``- collision`` on
     contact (d_min <= 0); ``- effort`` * mean(action^2); ``success`` on arrival;
-    ``closeness`` * exp(-d / ``closeness_scale``) every step (d: gripper-fruit
-    distance, m), 0 in the registered IDs: a dense shaping that training
-    configurations switch on (the progress term telescopes, so a policy parked
-    0.5 m short loses only 5 in all). It is positive and bounded, so ending an
-    episode early by a collision never pays, and a weight below ``success`` /
-    episode length keeps hovering worth less than arriving.
+    ``- distance`` * gripper-fruit distance (m) every step, 0 in the registered
+    IDs: a dense shaping that training configurations switch on (the progress
+    term telescopes, so a policy parked 0.5 m short loses only 5 in all). Being
+    negative, it makes ending an episode early pay, so train it with
+    ``terminate_on_collision=False`` (a collision then costs ``collision``
+    on every step in contact instead of ending the episode).
 
     Termination: the gripper within ``success_tolerance`` of the fruit centre,
     or a collision (if ``terminate_on_collision``). Truncation: the
@@ -115,8 +114,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         collision: float = 10.0,
         effort: float = 0.01,
         success: float = 10.0,
-        closeness: float = 0.0,
-        closeness_scale: float = 0.1,  # m
+        distance: float = 0.0,
         render_mode: str | None = None,
         width: int = 480,
         height: int = 360,
@@ -140,9 +138,8 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "collision": collision,
             "effort": effort,
             "success": success,
-            "closeness": closeness,
+            "distance": distance,
         }
-        self.closeness_scale = float(closeness_scale)
         self.render_mode, self.width, self.height = render_mode, width, height
 
         self.model, self.index = build_model(
@@ -280,7 +277,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "collision": -w["collision"] * float(collided),
             "effort": -w["effort"] * float(np.dot(a, a)) / len(a),
             "success": w["success"] * float(arrived),
-            "closeness": w["closeness"] * math.exp(-d_fruit / self.closeness_scale),
+            "distance": -w["distance"] * d_fruit,
         }
         self._d_fruit = d_fruit
         if self.render_mode is not None:

@@ -8,31 +8,31 @@ import pytest
 
 import motiongym  # noqa: F401
 
-# ID -> (the info keys whose sum is the distance, the default closeness scale)
-CASES = {
-    "motiongym/ExcavatorReach-v0": (("position_error", "angle_error"), 0.5),
-    "motiongym/HarvestArmPlanar-v0": (("distance_to_fruit",), 0.1),
-    "motiongym/HarvestArm-v0": (("distance_to_fruit",), 0.1),
-}
 
-
-@pytest.mark.parametrize("env_id", CASES)
-@pytest.mark.parametrize("weight", [0.0, 0.3])
-def test_closeness_term_decays_with_the_distance(env_id, weight):
-    keys, scale = CASES[env_id]
-    kwargs = {} if weight == 0.0 else {"closeness": weight}
-    env = gym.make(env_id, **kwargs)
+def test_reach_closeness_term_decays_with_the_error():
+    env = gym.make("motiongym/ExcavatorReach-v0", closeness=0.3)
     env.reset(seed=3)
     env.action_space.seed(3)
     for _ in range(5):
         _, reward, terminated, truncated, info = env.step(env.action_space.sample())
-        distance = sum(info[key] for key in keys)
-        expected = weight * np.exp(-distance / scale)
-        assert info["reward_closeness"] == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        error = info["position_error"] + info["angle_error"]
+        assert info["reward_closeness"] == pytest.approx(0.3 * np.exp(-error / 0.5), rel=1e-9)
         terms = [value for key, value in info.items() if key.startswith("reward_")]
         assert reward == pytest.approx(np.sum(terms))
-        if terminated or truncated:
-            break
+
+
+@pytest.mark.parametrize("env_id", ["motiongym/HarvestArmPlanar-v0", "motiongym/HarvestArm-v0"])
+@pytest.mark.parametrize("weight", [0.0, 0.3])
+def test_harvest_distance_term_is_weight_times_distance(env_id, weight):
+    env = gym.make(env_id, distance=weight, terminate_on_collision=False)
+    env.reset(seed=3)
+    env.action_space.seed(3)
+    for _ in range(5):
+        _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        expected = -weight * info["distance_to_fruit"]
+        assert info["reward_distance"] == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        terms = [value for key, value in info.items() if key.startswith("reward_")]
+        assert reward == pytest.approx(np.sum(terms))
 
 
 def test_dig_cycle_approach_term_is_progress_toward_the_subgoal_from_zone_to_truck():

@@ -143,7 +143,7 @@ def test_reward_terms_sum_and_info_keys():
         terms = {k: v for k, v in info.items() if k.startswith("reward_")}
         assert set(terms) == {
             f"reward_{t}"
-            for t in ("progress", "clearance", "collision", "effort", "success", "closeness")
+            for t in ("progress", "clearance", "collision", "effort", "success", "distance")
         }
         assert sum(terms.values()) == pytest.approx(reward)
         assert info["cost"] == float(info["min_distance"] < 0.03 or info["collision"])
