@@ -65,9 +65,9 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
     ``- distance`` * gripper-fruit distance (m) every step, 0 in the registered
     IDs: a dense shaping that training configurations switch on (the progress
     term telescopes, so a policy parked 0.5 m short loses only 5 in all). Being
-    negative, it makes ending an episode early pay, so train it with
-    ``terminate_on_collision=False`` (a collision then costs ``collision``
-    on every step in contact instead of ending the episode).
+    negative, it makes ending an episode on an obstacle cheaper than a long
+    miss; ``terminate_on_collision=False`` removes that way out (the configs
+    record how each choice trained).
 
     Termination: the gripper within ``success_tolerance`` of the fruit centre,
     or a collision (if ``terminate_on_collision``). Truncation: the
