@@ -58,10 +58,10 @@ def learning_curve_figure(curves: dict[str, Path], path: Path, env_id: str) -> P
             style = dict(color=f"C{n}", alpha=1.0 - 0.25 * k, label=name)
             ax_return.plot(steps, returns, **style)
             ax_success.plot(steps, successes, **style)
-    ax_return.set_ylabel("evaluation return")
+    ax_return.set_ylabel("evaluation return (training reward)")
     ax_success.set_ylabel("evaluation success rate")
     for ax in (ax_return, ax_success):
-        ax.set_xlabel("environment steps")
+        ax.set_xlabel("training steps (agent steps for -shared)")
     ax_success.legend(fontsize=7)
     figure.suptitle(f"{env_id}: learning curves (evaluation callback, deterministic)", fontsize=10)
     figure.tight_layout()
