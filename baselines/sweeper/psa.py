@@ -33,6 +33,20 @@ Choices where the paper is open (documented and tested):
 - Where the segment one width away is blocked (a strip narrower than the
   robot between the lane and a wall), the segment is moved back towards the
   lane, one cell at a time, until a configuration along it is free.
+- Steps 2-3 also look *behind* a lane that starts after a shift: where the
+  lane before it was blocked sooner (a cupboard's corner), the new lane's
+  extension backwards, in line with it, lies beside no lane, and neither
+  side segment holds it (:func:`behind_segment`). That segment, over the
+  configurations behind the lane known to be free and as long as the lane
+  before, is pushed when it holds unswept cells. (Without it such a strip,
+  one robot width wide along a wall, was left to CWA's scan, which found it
+  after the whole stack, usually from the far side of the map.) Mean travel
+  ratio over room seeds 0-19, maze seeds 0-19, apartment seeds 0-29 and the
+  reproduction's 50 procedural maps: 1.339 / 1.486 / 1.603 / 1.389 without,
+  1.337 / 1.490 / 1.554 / 1.381 with; apartment starts below the
+  exploration bound (:func:`motiongym.envs.sweeper.world.smartdfs_bound`)
+  23 -> 27 of 30. Looking behind a restarted run's first lane as well cost
+  on the room (1.367) and gained little elsewhere; not done.
 - A pushed entry keeps its whole side segment (start, heading, length, side):
   on popping, the restart point is the end of the segment's still-unswept
   part that is nearer to the robot (the paper's "start point" taken from
@@ -117,6 +131,13 @@ def side_segments(
         s = (start[0] + w * int(DR[side]), start[1] + w * int(DC[side]))
         out.append(Segment(s, heading, length, side))
     return out
+
+
+def behind_segment(start: tuple[int, int], heading: int, length: int, side: int) -> Segment:
+    """The virtual segment in line behind a lane that starts at ``start`` in ``heading``."""
+    back = (heading + 2) % 4
+    first = (start[0] + int(DR[back]), start[1] + int(DC[back]))
+    return Segment(first, back, length, side)
 
 
 def toward_lane(seg: Segment, j: int) -> Segment:

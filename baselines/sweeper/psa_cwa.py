@@ -22,7 +22,7 @@ from gymnasium import spaces
 
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper import cwa, psa, quadtree
-from motiongym.baselines.sweeper.belief import OBSTACLE, RobotMap
+from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
 from motiongym.envs.sweeper import world
 from motiongym.envs.sweeper.world import DC, DR
 
@@ -52,6 +52,7 @@ class Memory:
     run_heading: int | None = None
     run_side: int | None = None
     lane_start: tuple[int, int] | None = None
+    lane_length: int = 0  # configurations along the lane last ended
     first_lane: bool = True  # no shift yet in this run (its side may still flip)
     run: int = 0  # number of the current PSA run (stack entries carry the run that pushed them)
     retry: bool = False  # a transfer was aborted: take the stack's top entry next
@@ -73,6 +74,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     repush = True  # a popped segment goes back under the run it starts
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
     restart_axis = True  # a popped run may turn its lanes across (psa.restart_heading)
+    push_behind = True  # push the segment in line behind a lane that starts after a shift
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -147,6 +149,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
             if self._strip_unswept(m, seg):
                 m.stack.push(seg, m.run)
+        m.lane_length = abs(r - m.lane_start[0]) + abs(c - m.lane_start[1]) + 1
         # step 4: shift one width to the run's side, at the blocking point or,
         # where the side is blocked there, at the nearest point back along the lane;
         # a run's first shift may take the other side when the run's side is closed
@@ -218,8 +221,30 @@ class PsaCwaPolicy(ScriptedPolicy):
         return psa.lane_open(nocc, nsw[edge])
 
     def _shift(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        if self.push_behind:
+            self._push_behind(m, r, c)
         m.mode, m.lane_start = "lane", (r, c)
         return None
+
+    def _push_behind(self, m: Memory, r: int, c: int) -> None:
+        """Push the segment in line behind a lane about to start at ``(r, c)``.
+
+        It runs back from the lane's start, as long as the lane last ended,
+        over configurations known to be free, and is pushed when it holds
+        unswept cells (steps 2-3 for the cells no side segment covers).
+        """
+        seg = psa.behind_segment((r, c), m.run_heading, m.lane_length, m.run_side)
+        rr, cc = psa.segment_configs(seg)
+        known = 0
+        for cr, cc_ in zip(rr.tolist(), cc.tolist(), strict=True):
+            occ, _ = m.map.footprint(cr, cc_)
+            if (occ != FREE).any():
+                break
+            known += 1
+        if known:
+            seg = psa.Segment(seg.start, seg.heading, known, seg.side)
+            if self._strip_unswept(m, seg):
+                m.stack.push(seg, m.run)
 
     def _pop(self, m: Memory, r: int, c: int, h: int) -> int | None:
         """Take the next stack entry that still holds work and transfer there.

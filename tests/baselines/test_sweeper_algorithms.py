@@ -88,6 +88,13 @@ def test_side_segments_one_width_beside_the_lane() -> None:
     assert rows.tolist() == [13] * 11 and cols.tolist() == list(range(5, 16))
 
 
+def test_behind_segment_in_line_behind_the_lane_start() -> None:
+    seg = psa.behind_segment((6, 56), 3, 9, 0)  # a lane starting at (6, 56) heading south
+    assert seg == psa.Segment((5, 56), 1, 9, 0)  # from the cell behind, pointing north
+    rows, cols = psa.segment_configs(seg)
+    assert rows.tolist() == list(range(5, -4, -1)) and cols.tolist() == [56] * 9
+
+
 def test_first_target_skips_swept_and_takes_nearer_end() -> None:
     seg = psa.Segment((0, 0), 0, 10, 3)
     cfree = np.ones((3, 12), bool)

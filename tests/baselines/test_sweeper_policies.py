@@ -129,3 +129,21 @@ def test_pop_takes_the_nearest_entry_of_the_latest_run() -> None:
 def test_pop_after_an_aborted_transfer_retries_the_top_entry() -> None:
     near, far = ((8, 14), 1), ((13, 4), 1)
     assert _popping([near, far], retry=True) == (13, 6)
+
+
+def test_region_behind_the_last_lane_is_pushed_and_swept_by_psa() -> None:
+    # a cupboard along the north wall leaves a strip one robot width wide beside
+    # it; the fifth lane (cols 13-15, heading south) starts at the cupboard's
+    # corner with that strip behind it, beside no lane, so only the segment in
+    # line behind the lane holds it
+    grid = empty_room(16, 17)
+    grid[1:7, 1:13] = True
+    options = {"start": (7, 1), "heading": 3}
+    env = gym.make(ENV_ID, grid=grid)
+    policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, {})
+    info = run_episode(env, policy, 0, options)
+    assert info["is_success"]
+    assert info["memory"].log == [("transfer", (12, 13), (6, 13))]  # popped from the stack
+    policy.push_behind = False
+    info = run_episode(env, policy, 0, options)
+    assert info["memory"].log == [("restart", (12, 13), (4, 13))]  # found by CWA's scan

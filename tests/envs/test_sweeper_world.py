@@ -59,9 +59,32 @@ def test_entering_mask() -> None:
 
 def test_smartdfs_bound_empty_room() -> None:
     reach = np.ones((12, 18), bool)  # 12 x 18 floor: 4 x 6 blocks of 3 x 3
-    c, e, ratio = world.smartdfs_bound(reach, 3)
-    assert (c, e) == (24, 20)
-    assert ratio == pytest.approx(3 * (24 + 10 - 3) / (216 / 3))
+    bound = world.smartdfs_bound(reach, 3)
+    assert (bound.cells, bound.edges, bound.holes) == (24, 20, 0)
+    assert bound.steps == 24 + 10 - 3  # SmartDFS: C + E/2 - 3
+    assert bound.ratio == bound.simple_ratio == pytest.approx(3 * 31 / (216 / 3))
+
+
+def test_robot_scale_cells_split_where_a_thin_wall_crosses_a_block() -> None:
+    reach = np.ones((3, 9), bool)
+    reach[:, 4] = False  # a wall one cell thick through the middle block
+    # blocks 0 | 1a 1b | 2: the middle block holds a cell each side of the wall,
+    # each the neighbour of the block beside it only
+    assert world.robot_scale_cells(reach, 3) == (4, 16 - 4)
+    reach[1, 4] = True  # a door: the two halves touch inside the block, one cell
+    assert world.robot_scale_cells(reach, 3) == (3, 12 - 4)
+
+
+def test_obstacle_count_and_the_bound_around_obstacles() -> None:
+    reach = np.ones((12, 12), bool)
+    reach[0:2, 5:8] = False  # against the frame: part of the outside, not an obstacle
+    assert world.obstacle_count(reach) == 0
+    reach[5:7, 5:7] = False  # an island the robot can go round
+    reach[9, 2] = False  # and a pillar
+    assert world.obstacle_count(reach) == 2
+    bound = world.smartdfs_bound(reach, 3)
+    assert bound.steps == bound.cells + bound.edges / 2 + 3 * 2 - 2  # C + E/2 + 3H - 2
+    assert bound.simple_ratio < bound.ratio
 
 
 def test_bfs_distance_and_descend() -> None:
@@ -138,5 +161,5 @@ def test_generator_fifty_maps_closed_with_room_for_robot() -> None:
 def test_smartdfs_bound_blocks_anchored_at_the_start() -> None:
     reach = np.ones((12, 18), bool)
     assert world.smartdfs_bound(reach, 3, (3, 6)) == world.smartdfs_bound(reach, 3)
-    c, e, _ = world.smartdfs_bound(reach, 3, (1, 1))  # blocks straddle the floor's edges
-    assert (c, e) == (35, 24)
+    bound = world.smartdfs_bound(reach, 3, (1, 1))  # blocks straddle the floor's edges
+    assert (bound.cells, bound.edges) == (35, 24)
