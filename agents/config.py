@@ -6,7 +6,10 @@ the tuned choice, which ``motiongym train`` trains unless told another. A block'
 either the run settings below or keyword arguments of the algorithm's
 constructor (``learning_rate``, ``n_steps``, ...); any other key is rejected
 with its name. ``policy_kwargs`` is a mapping, never code: the activation
-function is named (``tanh``, ``relu``, ``elu``, ``leaky_relu``).
+function is named (``tanh``, ``relu``, ``elu``, ``leaky_relu``), and so is a
+features extractor (``features_extractor_class: sweeper_egocentric``, see
+:mod:`motiongym.agents.features`; its keywords in
+``features_extractor_kwargs``).
 
 Run settings:
 
@@ -41,6 +44,7 @@ import yaml
 
 from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
+from motiongym.agents.features import FEATURES_EXTRACTORS
 from motiongym.agents.predictors import algorithm_classes
 
 RUN_SETTINGS: dict[str, Any] = {
@@ -133,6 +137,14 @@ def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
         raise UsageError(
             f"{where}: activation_fn {activation!r} unknown; valid: {', '.join(ACTIVATIONS)}"
         )
+    extractor = config["policy_kwargs"].get("features_extractor_class")
+    if extractor is not None and extractor not in FEATURES_EXTRACTORS:
+        raise UsageError(
+            f"{where}: features_extractor_class {extractor!r} unknown; "
+            f"valid: {', '.join(FEATURES_EXTRACTORS)}"
+        )
+    if not isinstance(config["policy_kwargs"].get("features_extractor_kwargs", {}), dict):
+        raise UsageError(f"{where}: 'features_extractor_kwargs' must be a mapping")
     if config["vec_env"] not in VEC_ENVS:
         raise UsageError(f"{where}: vec_env must be one of {', '.join(VEC_ENVS)}")
     return config

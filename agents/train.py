@@ -51,6 +51,7 @@ from motiongym.agents.config import (
 )
 from motiongym.agents.environments import check_env_id, importable_id, short_name
 from motiongym.agents.errors import UsageError
+from motiongym.agents.features import FEATURES_EXTRACTORS
 from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
 from motiongym.agents.predictors import (
     CONFIG_FILE,
@@ -64,10 +65,12 @@ _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
 
 def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
-    """The block's ``policy_kwargs`` with the activation's name made a class."""
+    """The block's ``policy_kwargs`` with the activation's and extractor's names made classes."""
     kwargs = dict(config["policy_kwargs"])
     if "activation_fn" in kwargs:
         kwargs["activation_fn"] = getattr(torch.nn, ACTIVATIONS[kwargs["activation_fn"]])
+    if "features_extractor_class" in kwargs:
+        kwargs["features_extractor_class"] = FEATURES_EXTRACTORS[kwargs["features_extractor_class"]]
     return kwargs
 
 

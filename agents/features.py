@@ -1,0 +1,148 @@
+"""Features extractors that configs name in ``policy_kwargs`` (never code in YAML).
+
+A block's ``policy_kwargs`` may say ``features_extractor_class:
+sweeper_egocentric`` (a key of :data:`FEATURES_EXTRACTORS`) with its keywords in
+``features_extractor_kwargs``; ``motiongym.agents.train`` turns the name into
+the class.
+
+:class:`SweeperEgocentric` re-frames the sweeper's observation around the
+robot. The environment's windows and coarse maps are world-aligned (row 0
+north), so the same situation (a swept lane on the left, a wall ahead) reads
+differently for each heading and position, and an MLP has to learn it once
+per pose. Here every input is turned so that the robot's heading points up,
+and the coarse maps are shifted so that the robot's block is at the centre.
+It is a pure function of the current observation: the policy sees what the
+scripted policies see, in another frame, and remembers nothing.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import torch
+from gymnasium import spaces
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+from torch import nn
+
+
+def _quarter_turns(heading: torch.Tensor) -> torch.Tensor:
+    """Counter-clockwise quarter turns that bring ``heading`` (0 east, 1 north, ...) up."""
+    return (1 - heading) % 4
+
+
+def _rotated(grid: torch.Tensor) -> torch.Tensor:
+    """``(4, n)``: ``grid`` (a square of values) turned 0..3 quarter turns, flattened.
+
+    Gathering a flattened image at ``_rotated(arange)[k]`` turns the image
+    ``k`` quarter turns counter-clockwise (``torch.rot90``'s convention).
+    """
+    return torch.stack([torch.rot90(grid, k).flatten() for k in range(4)])
+
+
+class SweeperEgocentric(BaseFeaturesExtractor):
+    """The sweeper's observation in the robot's frame, through a small CNN.
+
+    Inputs (see ``SweeperEnv``'s observation table), for a batch of ``B``:
+
+    - local windows ``sensed`` and ``swept`` ``(S, S)`` around the footprint,
+      turned ``(1 - heading) mod 4`` quarter turns counter-clockwise so that
+      the heading points up (the footprint is at the window's centre, so the
+      turn keeps it there): ``2 S^2`` features, flattened;
+    - coarse maps ``sweep_map`` and ``obstacle_map`` ``(K, K)``: block
+      ``(i, j)`` covers cells ``[i bh, (i+1) bh) x [j bw, (j+1) bw)`` with
+      ``bh, bw = ceil(H / K), ceil(W / K)``. The robot's block is that of its
+      believed footprint's top-left cell ``(pose[0] // bh, pose[1] // bw)``.
+      The maps are re-sampled on a ``(2K - 1)^2`` grid centred on that block
+      (any block of the map stays in view wherever the robot is), turned like
+      the windows, with a third channel marking blocks outside the map (the
+      others are 0 there): ``(3, 2K - 1, 2K - 1)`` through three 3x3
+      stride-2 convolutions;
+    - the believed pose: row and column over ``H`` and ``W``, the heading
+      one-hot, the bump flag. Within a block the maps and, in swept floor,
+      the windows are the same at every cell, so without the pose those cells
+      look alike and a deterministic policy loops among them.
+
+    The observation gives the robot's cell, not its block, and ``H, W`` are
+    the map's, not the observation's: ``map_shape`` names them (the registered
+    room is 30 x 40). A policy built with it is for maps of that size. The
+    pose must reach the extractor raw (no VecNormalize on ``pose``).
+
+    Output: ``features_dim`` features (ReLU of a linear layer over the
+    concatenation).
+    """
+
+    def __init__(
+        self,
+        observation_space: spaces.Dict,
+        map_shape: Sequence[int],
+        features_dim: int = 64,
+        channels: Sequence[int] = (16, 32, 32),
+    ) -> None:
+        super().__init__(observation_space, features_dim)
+        shape = tuple(map_shape)
+        if len(shape) != 2 or not all(isinstance(n, int) and n > 0 for n in shape):
+            raise ValueError(f"map_shape must be two positive integers (H, W), got {map_shape!r}")
+        if not channels or not all(isinstance(n, int) and n > 0 for n in channels):
+            raise ValueError(f"channels must be positive integers, got {channels!r}")
+        S = math.isqrt(observation_space["sensed"].shape[0])
+        K = math.isqrt(observation_space["sweep_map"].shape[0])
+        self.K = K
+        self.register_buffer("map_size", torch.tensor(shape, dtype=torch.float32))
+        self.block = (-(-shape[0] // K), -(-shape[1] // K))  # (bh, bw), cells
+        # Blocks holding map cells: rows [0, ceil(H / bh)), columns [0, ceil(W / bw)).
+        self.n_blocks = (-(-shape[0] // self.block[0]), -(-shape[1] // self.block[1]))
+        self.register_buffer("window_index", _rotated(torch.arange(S * S).reshape(S, S)))
+        offsets = torch.arange(-(K - 1), K)
+        rows, cols = torch.meshgrid(offsets, offsets, indexing="ij")
+        self.register_buffer("row_offset", _rotated(rows))  # (4, (2K - 1)^2)
+        self.register_buffer("col_offset", _rotated(cols))
+        layers: list[nn.Module] = []
+        in_channels, side = 3, 2 * K - 1
+        for out_channels in channels:
+            layers += [nn.Conv2d(in_channels, out_channels, 3, stride=2), nn.ReLU()]
+            in_channels, side = out_channels, (side - 3) // 2 + 1
+        if side < 1:
+            raise ValueError(f"{len(channels)} stride-2 convolutions shrink a {2 * K - 1} map to 0")
+        self.cnn = nn.Sequential(*layers, nn.Flatten())
+        n_inputs = 2 * S * S + in_channels * side * side + 2 + 4 + 1
+        self.head = nn.Sequential(nn.Linear(n_inputs, features_dim), nn.ReLU())
+
+    def egocentric_maps(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        """``(B, 3, 2K - 1, 2K - 1)``: swept, obstacle and outside-the-map, robot-centred."""
+        pose = observations["pose"].round().long()
+        k = _quarter_turns(pose[:, 2].clamp(0, 3))
+        K, (bh, bw), (nr, nc) = self.K, self.block, self.n_blocks
+        rr = (pose[:, :1] // bh).clamp(0, K - 1) + self.row_offset[k]  # (B, (2K - 1)^2)
+        cc = (pose[:, 1:2] // bw).clamp(0, K - 1) + self.col_offset[k]
+        inside = ((rr >= 0) & (rr < nr) & (cc >= 0) & (cc < nc)).float()
+        index = rr.clamp(0, K - 1) * K + cc.clamp(0, K - 1)
+        swept = observations["sweep_map"].gather(1, index) * inside
+        obstacle = observations["obstacle_map"].gather(1, index) * inside
+        side = 2 * K - 1
+        return torch.stack([swept, obstacle, 1.0 - inside], 1).reshape(-1, 3, side, side)
+
+    def egocentric_windows(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        """``(B, 2, S^2)``: the sensed and swept windows turned heading-up, flattened."""
+        k = _quarter_turns(observations["pose"][:, 2].round().long().clamp(0, 3))
+        index = self.window_index[k]  # (B, S^2)
+        windows = (observations["sensed"].gather(1, index), observations["swept"].gather(1, index))
+        return torch.stack(windows, 1)
+
+    def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        pose = observations["pose"]
+        heading = nn.functional.one_hot(pose[:, 2].round().long().clamp(0, 3), 4)
+        features = (
+            self.egocentric_windows(observations).flatten(1),
+            self.cnn(self.egocentric_maps(observations)),
+            pose[:, :2] / self.map_size,
+            heading.float(),
+            pose[:, 3:],
+        )
+        return self.head(torch.cat(features, 1))
+
+
+# Names a config may give ``features_extractor_class`` -> the class.
+FEATURES_EXTRACTORS: dict[str, type[BaseFeaturesExtractor]] = {
+    "sweeper_egocentric": SweeperEgocentric
+}
