@@ -34,9 +34,14 @@ DEFAULT_EPISODES = 20
 
 
 def pooled_evaluation(folder: Path) -> tuple[Evaluation, dict]:
-    """A shipped agent's every training seed on the held-out episodes, as one evaluation."""
+    """A shipped agent's every training seed on the held-out episodes, as one evaluation.
+
+    Its label says ``sampled`` when the runs acted on sampled actions
+    (``deterministic: false``), not on their most likely ones.
+    """
     metrics = json.loads((folder / METRICS).read_text())
-    label = f"{metrics['policy']} ({len(metrics['runs'])} seeds)"
+    sampled = not all(run.get("deterministic", True) for run in metrics["runs"])
+    label = f"{metrics['policy']} ({len(metrics['runs'])} seeds{', sampled' if sampled else ''})"
     episodes = [episode for run in metrics["runs"] for episode in run["episodes"]]
     return Evaluation(metrics["env_id"], label, episodes), metrics
 
@@ -63,7 +68,7 @@ def learning_curve_figure(curves: dict[str, Path], path: Path, env_id: str) -> P
     for ax in (ax_return, ax_success):
         ax.set_xlabel("training steps (agent steps for -shared)")
     ax_success.legend(fontsize=7)
-    figure.suptitle(f"{env_id}: learning curves (evaluation callback, deterministic)", fontsize=10)
+    figure.suptitle(f"{env_id}: learning curves (evaluation callback)", fontsize=10)
     figure.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=100)

@@ -30,6 +30,12 @@ vec_env        ``dummy``, ``subproc``, ``native`` (the ID's own       dummy
 eval_freq      steps between evaluations (over all envs)             10000
 n_eval_episodes episodes per evaluation                              5
 checkpoint_freq steps between checkpoints (over all envs)            50000
+deterministic  how the model acts in evaluations (the training        true
+               callback's, ``evaluate``, ``compare``, ``ship``): its
+               most likely action (true) or one sampled from its
+               distribution (false), for a memoryless policy whose
+               mode loops where its samples do not; saved in the
+               run's ``config.yml`` and so honoured for shipped models
 ============== ===================================================== ==========
 """
 
@@ -58,6 +64,7 @@ RUN_SETTINGS: dict[str, Any] = {
     "eval_freq": 10_000,
     "n_eval_episodes": 5,
     "checkpoint_freq": 50_000,
+    "deterministic": True,
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
@@ -145,6 +152,8 @@ def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
         )
     if not isinstance(config["policy_kwargs"].get("features_extractor_kwargs", {}), dict):
         raise UsageError(f"{where}: 'features_extractor_kwargs' must be a mapping")
+    if not isinstance(config["deterministic"], bool):
+        raise UsageError(f"{where}: 'deterministic' must be true or false")
     if config["vec_env"] not in VEC_ENVS:
         raise UsageError(f"{where}: vec_env must be one of {', '.join(VEC_ENVS)}")
     return config

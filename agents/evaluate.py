@@ -1,7 +1,11 @@
 """Running a predictor on seeded episodes and summarising what ``info`` reports.
 
 Episode ``i`` of an evaluation is reset with ``seed + i``: every policy run
-with the same ``seed`` and ``n_episodes`` faces the same scenarios.
+with the same ``seed`` and ``n_episodes`` faces the same scenarios. Torch's
+random generator is seeded with the same number for the episode (and
+restored after it), so a model that samples its actions (a run with
+``deterministic: false``) acts the same on the same episode in every
+evaluation, whatever ran before.
 
 What is measured: the episode's return and length, and every key of the
 environment's ``metadata["info_measures"]`` (``{key: how}``, how being
@@ -21,6 +25,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+import torch
 from scipy import stats
 from tqdm.auto import tqdm
 
@@ -56,17 +61,19 @@ def run_episode(env: gym.Env, predictor: Any, seed: int) -> dict[str, float]:
     state, episode_start = None, np.ones(1, dtype=bool)
     trace: dict[str, list[float]] = {key: [] for key in measures}
     episode_return, length, done = 0.0, 0, False
-    while not done:
-        action, state = predictor.predict(
-            observation, state=state, episode_start=episode_start, deterministic=True
-        )
-        observation, reward, terminated, truncated, info = env.step(action)
-        episode_start = np.zeros(1, dtype=bool)
-        episode_return += float(reward)
-        length += 1
-        done = terminated or truncated
-        for key in measures:
-            trace[key].append(float(info[key]))
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(seed)
+        while not done:
+            action, state = predictor.predict(
+                observation, state=state, episode_start=episode_start, deterministic=True
+            )
+            observation, reward, terminated, truncated, info = env.step(action)
+            episode_start = np.zeros(1, dtype=bool)
+            episode_return += float(reward)
+            length += 1
+            done = terminated or truncated
+            for key in measures:
+                trace[key].append(float(info[key]))
     result = {"seed": seed, "return": episode_return, "length": length}
     for key, how in measures.items():
         result[key] = AGGREGATIONS[how](np.asarray(trace[key]))

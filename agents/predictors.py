@@ -10,7 +10,9 @@ episode_start, deterministic)``: a scripted policy from
   observations, ``vecnormalize.pkl``, which is applied here). A run whose
   ``config.yml`` says ``vec_env: pettingzoo`` trained one policy for every
   agent; it acts in the single-agent environment through
-  :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`.
+  :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`. A run whose
+  ``config.yml`` says ``deterministic: false`` samples its actions
+  (:class:`SampledModel`) whatever its caller asks.
 
 The algorithm of a bare ``.zip`` is read from the policy class saved in it
 (PPO and A2C share theirs, and either predicts the same way).
@@ -86,6 +88,23 @@ class MaskedModel:
         )
 
 
+class SampledModel:
+    """A model that samples its actions, for a run trained to be evaluated that way.
+
+    The run's ``deterministic: false`` setting (see
+    :mod:`motiongym.agents.config`) overrides the caller's ``deterministic``:
+    the harness asks every policy for its deterministic action, and this one's
+    is a sample. :func:`motiongym.agents.evaluate.run_episode` seeds the
+    sampling from the episode's seed.
+    """
+
+    def __init__(self, model: Any) -> None:
+        self.model = model
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return self.model.predict(observation, state, episode_start, deterministic=False)
+
+
 def model_path(path: Path) -> Path:
     """The model file of a path that is a ``.zip`` or a run folder."""
     candidate = path / MODEL_FILE if path.is_dir() else path
@@ -130,20 +149,26 @@ def _normalized(model: BaseAlgorithm, file: Path, venv: VecEnv) -> Any:
     return NormalizedModel(model, normalization)
 
 
-def trained_shared_policy(file: Path) -> bool:
-    """Whether the run beside ``file`` shared one policy among agents (``vec_env: pettingzoo``)."""
+def run_config(file: Path) -> dict[str, Any]:
+    """The resolved configuration of the run beside the model ``file`` ({} for a bare model)."""
     config_file = file.parent / CONFIG_FILE
     if not config_file.is_file():
-        return False
+        return {}
     config = yaml.safe_load(config_file.read_text())
-    return isinstance(config, dict) and config.get("vec_env") == "pettingzoo"
+    return config if isinstance(config, dict) else {}
+
+
+def trained_shared_policy(file: Path) -> bool:
+    """Whether the run beside ``file`` shared one policy among agents (``vec_env: pettingzoo``)."""
+    return run_config(file).get("vec_env") == "pettingzoo"
 
 
 def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
     """Load a trained model and check it was built for ``env``'s spaces.
 
     A shared-policy run acts in ``env`` (the single-agent view) through
-    :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`.
+    :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`; a run with
+    ``deterministic: false`` through :class:`SampledModel`.
     """
     file = model_path(path)
     model = saved_algorithm(file).load(file, device="cpu")
@@ -151,11 +176,14 @@ def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
         venv = SharedPolicyVecEnv(parallel_factory(env_id), n_copies=1)
         _check_spaces(model, venv, file, f"a shared-policy agent of {env_id}")
         check_single_agent_view(venv, env, env_id)
-        return SharedPolicyPredictor(_normalized(model, file, venv), venv.n_agents)
-    _check_spaces(model, env, file, f"the {env_id} environment")
-    predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
-    if isinstance(model, MaskablePPO):
-        return MaskedModel(predictor, env)
+        predictor = SharedPolicyPredictor(_normalized(model, file, venv), venv.n_agents)
+    else:
+        _check_spaces(model, env, file, f"the {env_id} environment")
+        predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
+        if isinstance(model, MaskablePPO):
+            predictor = MaskedModel(predictor, env)
+    if not run_config(file).get("deterministic", True):
+        predictor = SampledModel(predictor)
     return predictor
 
 

@@ -108,7 +108,8 @@ def ship(
     ``compare`` uses) in the registered task (training-only ``env_kwargs``
     such as a curriculum's are not applied). The best run (success rate, then
     mean return) is copied into ``pretrained/<Name>-vN/<label>/`` with
-    ``metrics.json``: each run's summary and episodes, and the summary pooled
+    ``metrics.json``: each run's summary and episodes (and whether it acted on
+    its most likely or on sampled actions, its ``deterministic`` setting), and the summary pooled
     over every run's episodes (the reported "over seeds and episodes"
     figures); ``learning_curves.csv``: every run's evaluation-callback curve.
     The manifest is written last.
@@ -136,7 +137,14 @@ def ship(
     for run_dir, config in zip(run_dirs, configs, strict=True):
         evaluation = evaluate(env, load_model(run_dir, env, env_id), seeds, env_id, label)
         pooled.episodes += evaluation.episodes
-        runs.append({"run": run_dir.name, "training_seed": config["seed"], **evaluation.to_json()})
+        runs.append(
+            {
+                "run": run_dir.name,
+                "training_seed": config["seed"],
+                "deterministic": config.get("deterministic", True),
+                **evaluation.to_json(),
+            }
+        )
     env.close()
 
     def score(run: dict) -> tuple[float, float]:

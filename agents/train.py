@@ -195,7 +195,7 @@ def train(
             n_eval_episodes=config["n_eval_episodes"] * eval_venv.num_envs,
             best_model_save_path=str(eval_dir),
             log_path=str(eval_dir),
-            deterministic=True,
+            deterministic=config["deterministic"],
             verbose=0,
         ),
         CheckpointCallback(
