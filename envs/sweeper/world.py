@@ -87,14 +87,38 @@ def entering_mask(dr: int, dc: int, w: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class SmartDfsBound:
-    """SmartDFS's travel bound on one map at robot scale (see :func:`smartdfs_bound`)."""
+    """The exploration bound on one map at robot scale (see :func:`smartdfs_bound`)."""
 
     cells: int  # C: cells of the robot-scale polygon
     edges: int  # E: their boundary edges
     holes: int  # H: obstacles the robot can travel round
-    steps: float  # the bound in robot steps of w cells
-    ratio: float  # w * steps over the lower bound area / w
-    simple_ratio: float  # the same with the simple-polygon bound C + E/2 - 3
+    area: int  # reachable cells of the map
+    w: int  # robot width, cells (a step is w cells)
+
+    @property
+    def simple_steps(self) -> float:
+        """SmartDFS's bound for a polygon without holes, ``C + E/2 - 3`` steps."""
+        return self.cells + self.edges / 2.0 - 3.0
+
+    @property
+    def steps(self) -> float:
+        """The bound that applies, in steps: ``C + E/2 + 3H - 2`` around ``H > 0`` obstacles."""
+        if not self.holes:
+            return self.simple_steps
+        return self.cells + self.edges / 2.0 + 3.0 * self.holes - 2.0
+
+    @property
+    def ratio(self) -> float:
+        """``w * steps`` over the lower bound ``area / w``."""
+        return self._over_lower_bound(self.steps)
+
+    @property
+    def simple_ratio(self) -> float:
+        """The same with the no-hole formula ``C + E/2 - 3`` (stricter on a map with holes)."""
+        return self._over_lower_bound(self.simple_steps)
+
+    def _over_lower_bound(self, steps: float) -> float:
+        return self.w * self.w * steps / self.area if self.area else float("inf")
 
 
 def robot_scale_cells(
@@ -158,11 +182,7 @@ def smartdfs_bound(
     over the lower bound ``area / w``.
     """
     c_count, edges = robot_scale_cells(reachable, w, anchor)
-    holes = obstacle_count(reachable)
-    simple = c_count + edges / 2.0 - 3.0
-    steps = c_count + edges / 2.0 + 3.0 * holes - 2.0 if holes else simple
-    per_step = w * w / float(reachable.sum()) if reachable.any() else float("inf")
-    return SmartDfsBound(c_count, edges, holes, steps, steps * per_step, simple * per_step)
+    return SmartDfsBound(c_count, edges, obstacle_count(reachable), int(reachable.sum()), w)
 
 
 def bfs_distance(free: np.ndarray, start: tuple[int, int]) -> np.ndarray:

@@ -83,7 +83,11 @@ def test_obstacle_count_and_the_bound_around_obstacles() -> None:
     reach[9, 2] = False  # and a pillar
     assert world.obstacle_count(reach) == 2
     bound = world.smartdfs_bound(reach, 3)
+    # every block stays one piece and touches its neighbours: C = 16, E = 16 (the frame)
+    assert (bound.cells, bound.edges, bound.holes, bound.area) == (16, 16, 2, 133)
     assert bound.steps == bound.cells + bound.edges / 2 + 3 * 2 - 2  # C + E/2 + 3H - 2
+    assert bound.steps == 28 and bound.simple_steps == 21
+    assert bound.ratio == pytest.approx(9 * 28 / 133)
     assert bound.simple_ratio < bound.ratio
 
 
