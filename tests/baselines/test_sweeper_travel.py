@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
-from motiongym.baselines.sweeper.run import sweep
+from motiongym.baselines.registry import make_policy
+from motiongym.baselines.sweeper.run import run_episode, sweep
 from motiongym.envs.sweeper import world
 from motiongym.envs.sweeper.generator import empty_room
 
@@ -28,13 +29,14 @@ ENV_ID = "motiongym/Sweeper-v0"
 
 
 def _ratios(map_name: str, seeds: range) -> tuple[np.ndarray, np.ndarray]:
-    """Travel ratio and exploration-bound ratio per seeded random start."""
-    ours, bound = [], []
+    """Travel ratio and exploration-bound ratio of PSA + CWA per seeded random start."""
     env = gym.make(ENV_ID, map_name=map_name)
+    kwargs = {**gym.spec(ENV_ID).kwargs, "map_name": map_name}
+    policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, kwargs)
+    ours, bound = [], []
     for seed in seeds:
-        info = sweep(map_name, seed=seed)
-        assert info["is_success"]
-        env.reset(seed=seed)
+        info = run_episode(env, policy, seed)
+        assert info["is_success"], (map_name, seed)
         sc = env.unwrapped.scenario
         ours.append(info["travel_ratio"])
         bound.append(world.smartdfs_bound(sc.reachable, 3, sc.start).ratio)
@@ -118,20 +120,7 @@ def test_apartment_travel_below_the_exploration_bound_from_every_start() -> None
 @pytest.fixture(scope="module")
 def procedural() -> tuple[np.ndarray, np.ndarray]:
     """Travel and bound ratios on the reproduction's 50 procedural maps (seeds 1000-1049)."""
-    from motiongym.baselines.registry import make_policy
-    from motiongym.baselines.sweeper.run import run_episode
-
-    env = gym.make(ENV_ID, map_name="random")
-    kwargs = {**gym.spec(ENV_ID).kwargs, "map_name": "random"}
-    policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, kwargs)
-    ours, bound = [], []
-    for seed in range(1000, 1050):
-        info = run_episode(env, policy, seed)
-        assert info["is_success"], seed
-        sc = env.unwrapped.scenario
-        ours.append(info["travel_ratio"])
-        bound.append(world.smartdfs_bound(sc.reachable, 3, sc.start).ratio)
-    return np.array(ours), np.array(bound)
+    return _ratios("random", range(1000, 1050))
 
 
 def test_procedural_travel(procedural) -> None:
