@@ -158,11 +158,6 @@ def run_config(file: Path) -> dict[str, Any]:
     return config if isinstance(config, dict) else {}
 
 
-def trained_shared_policy(file: Path) -> bool:
-    """Whether the run beside ``file`` shared one policy among agents (``vec_env: pettingzoo``)."""
-    return run_config(file).get("vec_env") == "pettingzoo"
-
-
 def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
     """Load a trained model and check it was built for ``env``'s spaces.
 
@@ -172,7 +167,8 @@ def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
     """
     file = model_path(path)
     model = saved_algorithm(file).load(file, device="cpu")
-    if trained_shared_policy(file):
+    config = run_config(file)
+    if config.get("vec_env") == "pettingzoo":  # one policy shared among the agents
         venv = SharedPolicyVecEnv(parallel_factory(env_id), n_copies=1)
         _check_spaces(model, venv, file, f"a shared-policy agent of {env_id}")
         check_single_agent_view(venv, env, env_id)
@@ -182,7 +178,7 @@ def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
         predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
         if isinstance(model, MaskablePPO):
             predictor = MaskedModel(predictor, env)
-    if not run_config(file).get("deterministic", True):
+    if not config.get("deterministic", True):
         predictor = SampledModel(predictor)
     return predictor
 
