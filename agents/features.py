@@ -26,6 +26,11 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
 
+def _heading(pose: torch.Tensor) -> torch.Tensor:
+    """``(B,)``: the believed heading (0 east, 1 north, ...) as an index."""
+    return pose[:, 2].round().long().clamp(0, 3)
+
+
 def _quarter_turns(heading: torch.Tensor) -> torch.Tensor:
     """Counter-clockwise quarter turns that bring ``heading`` (0 east, 1 north, ...) up."""
     return (1 - heading) % 4
@@ -111,7 +116,7 @@ class SweeperEgocentric(BaseFeaturesExtractor):
     def egocentric_maps(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         """``(B, 3, 2K - 1, 2K - 1)``: swept, obstacle and outside-the-map, robot-centred."""
         pose = observations["pose"].round().long()
-        k = _quarter_turns(pose[:, 2].clamp(0, 3))
+        k = _quarter_turns(_heading(observations["pose"]))
         K, (bh, bw), (nr, nc) = self.K, self.block, self.n_blocks
         rr = (pose[:, :1] // bh).clamp(0, K - 1) + self.row_offset[k]  # (B, (2K - 1)^2)
         cc = (pose[:, 1:2] // bw).clamp(0, K - 1) + self.col_offset[k]
@@ -124,14 +129,14 @@ class SweeperEgocentric(BaseFeaturesExtractor):
 
     def egocentric_windows(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         """``(B, 2, S^2)``: the sensed and swept windows turned heading-up, flattened."""
-        k = _quarter_turns(observations["pose"][:, 2].round().long().clamp(0, 3))
+        k = _quarter_turns(_heading(observations["pose"]))
         index = self.window_index[k]  # (B, S^2)
         windows = (observations["sensed"].gather(1, index), observations["swept"].gather(1, index))
         return torch.stack(windows, 1)
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         pose = observations["pose"]
-        heading = nn.functional.one_hot(pose[:, 2].round().long().clamp(0, 3), 4)
+        heading = nn.functional.one_hot(_heading(pose), 4)
         features = (
             self.egocentric_windows(observations).flatten(1),
             self.cnn(self.egocentric_maps(observations)),
