@@ -45,7 +45,7 @@ Choices where the paper is open (documented and tested):
   reproduction's 50 procedural maps: 1.339 / 1.486 / 1.603 / 1.389 without,
   1.337 / 1.490 / 1.554 / 1.381 with; apartment starts below the
   exploration bound (:func:`motiongym.envs.sweeper.world.smartdfs_bound`)
-  23 -> 27 of 30. Looking behind a restarted run's first lane as well cost
+  22 -> 27 of 30. Looking behind a restarted run's first lane as well cost
   on the room (1.367) and gained little elsewhere; not done.
 - A pushed entry keeps its whole side segment (start, heading, length, side):
   on popping, the restart point is the end of the segment's still-unswept
