@@ -54,10 +54,43 @@ def info_measures(env: gym.Env) -> dict[str, str]:
     return measures
 
 
-def run_episode(env: gym.Env, predictor: Any, seed: int) -> dict[str, float]:
-    """One episode from ``reset(seed=seed)``; its return, length and measures."""
+@dataclass
+class Step:
+    """What a per-step hook sees: the step's index (0-based), the predictor that
+    acted, the observation it acted on, its action and what ``env.step`` returned."""
+
+    index: int
+    predictor: Any
+    observation: Any
+    action: Any
+    next_observation: Any
+    reward: float
+    terminated: bool
+    truncated: bool
+    info: dict[str, Any]
+
+
+StepHook = Callable[[Step], None]
+
+
+def run_episode(
+    env: gym.Env,
+    predictor: Any,
+    seed: int,
+    hook: StepHook | None = None,
+    options: dict[str, Any] | None = None,
+) -> dict[str, float]:
+    """One episode from ``reset(seed=seed, options=options)``; its return, length
+    and measures.
+
+    The one episode loop of motiongym: ``evaluate``, ``compare``,
+    ``benchmarks`` and every reproduction run their episodes through it.
+    ``hook``, if given, is called after every step with a :class:`Step`; a
+    reproduction collects what it needs there (a policy's public
+    ``diagnostics()``, a world's measure) instead of writing its own loop.
+    """
     measures = info_measures(env)
-    observation, _ = env.reset(seed=seed)
+    observation, _ = env.reset(seed=seed, options=options)
     state, episode_start = None, np.ones(1, dtype=bool)
     trace: dict[str, list[float]] = {key: [] for key in measures}
     episode_return, length, done = 0.0, 0, False
@@ -67,7 +100,22 @@ def run_episode(env: gym.Env, predictor: Any, seed: int) -> dict[str, float]:
             action, state = predictor.predict(
                 observation, state=state, episode_start=episode_start, deterministic=True
             )
+            previous = observation
             observation, reward, terminated, truncated, info = env.step(action)
+            if hook is not None:
+                hook(
+                    Step(
+                        length,
+                        predictor,
+                        previous,
+                        action,
+                        observation,
+                        float(reward),
+                        bool(terminated),
+                        bool(truncated),
+                        info,
+                    )
+                )
             episode_start = np.zeros(1, dtype=bool)
             episode_return += float(reward)
             length += 1

@@ -62,6 +62,22 @@ class ScriptedPolicy(ABC):
         """Forget every episode in progress."""
         self._memories = []
 
+    def diagnostics(self, index: int = 0) -> dict[str, Any]:
+        """What the policy knows of its episode in progress (sub-environment ``index``).
+
+        The public view that evaluations and reproductions read (a plan's
+        delay, whether the policy has declared itself done, ...), so that
+        none of them reads private memory. Empty where a policy has nothing to
+        report; each policy documents its keys.
+        """
+        if not self._memories:
+            return {}
+        return self.describe(self._memories[index])
+
+    def describe(self, memory: Any) -> dict[str, Any]:
+        """``diagnostics()`` of one memory; override to report (default: nothing)."""
+        return {}
+
     def predict(
         self,
         observation: Any,
