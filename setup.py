@@ -23,6 +23,7 @@ setup(
     packages=packages,
     package_dir=PACKAGE_DIRS,
     package_data={
+        "motiongym": ["py.typed"],
         "": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.pkl"],
         # shipped models: pretrained/<ID>/<label>/ are folders, not packages
         "motiongym.agents": ["pretrained/*/*/*"],
