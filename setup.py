@@ -24,7 +24,7 @@ setup(
     package_dir=PACKAGE_DIRS,
     package_data={
         "motiongym": ["py.typed"],
-        "": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.pkl"],
+        "": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.npz"],
         # shipped models: pretrained/<ID>/<label>/ are folders, not packages
         "motiongym.agents": ["pretrained/*/*/*"],
     },

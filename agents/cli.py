@@ -44,7 +44,7 @@ def _evaluations(env_id: str, policies: list[str], args: argparse.Namespace) -> 
     seeds = range(args.seed, args.seed + args.episodes)
     results = []
     for policy in policies:
-        predictor = load_predictor(policy, env_id, env, env_kwargs)
+        predictor = load_predictor(policy, env_id, env, env_kwargs, trust=args.trust)
         label = policy_label(policy)
         results.append(evaluate(env, predictor, seeds, env_id, label, not args.no_progress))
     env.close()
@@ -111,8 +111,8 @@ def cmd_train(args: argparse.Namespace) -> None:
 
 
 def cmd_ship(args: argparse.Namespace) -> None:
-    from motiongym.agents.pretrained import ship
     from motiongym.agents.report import console
+    from motiongym.agents.ship import ship
 
     console.print(f"shipped to {ship(args.run_dirs, n_episodes=args.episodes)}")
 
@@ -159,10 +159,15 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--out", type=Path, default=Path("results"), help="output folder")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--trust",
+        action="store_true",
+        help="load a model folder without manifest.json (nothing in it is unpickled either way)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from motiongym.agents.predictors import algorithm_classes
+    from motiongym.agents.model_files import algorithm_classes
     from motiongym.agents.reproduce import EXPERIMENTS
 
     parser = argparse.ArgumentParser(

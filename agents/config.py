@@ -51,7 +51,7 @@ import yaml
 from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
-from motiongym.agents.predictors import algorithm_classes
+from motiongym.agents.model_files import algorithm_classes
 
 RUN_SETTINGS: dict[str, Any] = {
     "n_envs": 1,

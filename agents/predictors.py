@@ -7,7 +7,9 @@ episode_start, deterministic)``: a scripted policy from
 * a scripted policy's name declared for the environment ID (``psa-cwa``);
 * a trained model: a ``.zip`` written by SB3, or a run folder written by
   ``motiongym train`` (holding ``model.zip`` and, if the run normalised
-  observations, ``vecnormalize.pkl``, which is applied here). A run whose
+  observations, ``vecnormalize.npz``, which is applied here). Nothing in a
+  model folder is unpickled (:mod:`motiongym.agents.model_files`); a folder's
+  ``manifest.json`` is verified first, and one without needs ``trust``. A run whose
   ``config.yml`` says ``vec_env: pettingzoo`` trained one policy for every
   agent; it acts in the single-agent environment through
   :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`. A run whose
@@ -27,32 +29,28 @@ import gymnasium as gym
 import yaml
 from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
-from stable_baselines3.common.save_util import load_from_zip_file
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecNormalize
 
 from motiongym.agents.environments import resolved_env_kwargs
 from motiongym.agents.errors import UsageError
+from motiongym.agents.model_files import (
+    NORMALIZATION_FILE,
+    PICKLED_NORMALIZATION,
+    load_archive,
+    load_normalization,
+    warn,
+)
 from motiongym.agents.multiagent import (
     SharedPolicyPredictor,
     SharedPolicyVecEnv,
     check_single_agent_view,
     parallel_factory,
 )
-from motiongym.agents.pretrained import pretrained_models, verify_manifest
+from motiongym.agents.pretrained import MANIFEST, pretrained_models, verify_manifest
 from motiongym.baselines import make_policy, scripted_policies
 
 MODEL_FILE = "model.zip"
-NORMALIZATION_FILE = "vecnormalize.pkl"
 CONFIG_FILE = "config.yml"
-
-
-def algorithm_classes() -> dict[str, type[BaseAlgorithm]]:
-    """The SB3 and sb3-contrib algorithms by lower-case name."""
-    from sb3_contrib import TQC, MaskablePPO, RecurrentPPO
-    from stable_baselines3 import A2C, DQN, PPO, SAC, TD3
-
-    classes = [PPO, A2C, SAC, TD3, DQN, MaskablePPO, RecurrentPPO, TQC]
-    return {cls.__name__.lower(): cls for cls in classes}
 
 
 class NormalizedModel:
@@ -113,40 +111,17 @@ def model_path(path: Path) -> Path:
     return candidate
 
 
-def saved_algorithm(path: Path) -> type[BaseAlgorithm]:
-    """The algorithm class able to load the SB3 model saved at ``path``."""
-    try:
-        data, _, _ = load_from_zip_file(path, device="cpu", print_system_info=False)
-    except Exception as error:  # a corrupt or foreign file: name it
-        raise UsageError(f"{path} is not a Stable-Baselines3 model file ({error})") from error
-    policy_module = getattr((data or {}).get("policy_class"), "__module__", "?")
-    # The first algorithm whose policies live in that module (PPO before A2C).
-    for algorithm in algorithm_classes().values():
-        if any(cls.__module__ == policy_module for cls in algorithm.policy_aliases.values()):
-            return algorithm
-    raise UsageError(f"{path}: no known algorithm saves policies from {policy_module!r}")
-
-
-def _check_spaces(model: BaseAlgorithm, owner: Any, file: Path, what: str) -> None:
-    """Raise unless ``model`` was built for ``owner``'s observation and action spaces."""
-    for kind in ("observation_space", "action_space"):
-        trained, expected = getattr(model, kind), getattr(owner, kind)
-        if trained != expected:
-            raise UsageError(
-                f"model {file} was trained for another {kind.replace('_', ' ')}: "
-                f"{trained} ({what} has {expected})"
-            )
-
-
 def _normalized(model: BaseAlgorithm, file: Path, venv: VecEnv) -> Any:
     """``model`` behind the run's saved observation normalisation, if it has one."""
     normalization_file = file.parent / NORMALIZATION_FILE
     if not normalization_file.is_file():
+        if (file.parent / PICKLED_NORMALIZATION).is_file():
+            raise UsageError(
+                f"{file.parent / PICKLED_NORMALIZATION} is a pickle, which motiongym never "
+                f"loads; the run's statistics are read from {NORMALIZATION_FILE} (plain arrays)"
+            )
         return model
-    normalization = VecNormalize.load(str(normalization_file), venv)
-    normalization.training = False
-    normalization.norm_reward = False
-    return NormalizedModel(model, normalization)
+    return NormalizedModel(model, load_normalization(normalization_file, venv))
 
 
 def run_config(file: Path) -> dict[str, Any]:
@@ -154,27 +129,57 @@ def run_config(file: Path) -> dict[str, Any]:
     config_file = file.parent / CONFIG_FILE
     if not config_file.is_file():
         return {}
-    config = yaml.safe_load(config_file.read_text())
+    try:
+        config = yaml.safe_load(config_file.read_text())
+    except yaml.YAMLError as error:
+        raise UsageError(f"{config_file}: not valid YAML ({error})") from error
     return config if isinstance(config, dict) else {}
 
 
-def load_model(path: Path, env: gym.Env, env_id: str) -> Any:
+def check_provenance(file: Path, trust: bool) -> None:
+    """Verify the manifest of the folder holding ``file``; without one, require ``trust``."""
+    folder = file.parent
+    if (folder / MANIFEST).is_file():
+        verify_manifest(folder)
+        return
+    if not trust:
+        raise UsageError(
+            f"{folder} has no {MANIFEST} (motiongym train and ship write one); "
+            "pass --trust to load it anyway"
+        )
+    warn(f"loading {file} without a manifest (--trust); nothing in it is unpickled")
+
+
+def _run_policy_kwargs(config: dict[str, Any]) -> dict[str, Any] | None:
+    if not config:
+        return None
+    from motiongym.agents.train import policy_kwargs
+
+    return policy_kwargs(config)
+
+
+def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> Any:
     """Load a trained model and check it was built for ``env``'s spaces.
 
+    Nothing from the folder is unpickled (:mod:`motiongym.agents.model_files`);
+    its manifest is verified first, and a folder without one needs ``trust``.
     A shared-policy run acts in ``env`` (the single-agent view) through
     :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`; a run with
     ``deterministic: false`` through :class:`SampledModel`.
     """
     file = model_path(path)
-    model = saved_algorithm(file).load(file, device="cpu")
+    check_provenance(file, trust)
     config = run_config(file)
+    kwargs = _run_policy_kwargs(config)
     if config.get("vec_env") == "pettingzoo":  # one policy shared among the agents
         venv = SharedPolicyVecEnv(parallel_factory(env_id), n_copies=1)
-        _check_spaces(model, venv, file, f"a shared-policy agent of {env_id}")
+        what = f"a shared-policy agent of {env_id}"
+        model = load_archive(file, venv.observation_space, venv.action_space, what, kwargs)
         check_single_agent_view(venv, env, env_id)
         predictor = SharedPolicyPredictor(_normalized(model, file, venv), venv.n_agents)
     else:
-        _check_spaces(model, env, file, f"the {env_id} environment")
+        what = f"the {env_id} environment"
+        model = load_archive(file, env.observation_space, env.action_space, what, kwargs)
         predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
         if isinstance(model, MaskablePPO):
             predictor = MaskedModel(predictor, env)
@@ -189,19 +194,23 @@ def available_policies(env_id: str) -> list[str]:
 
 
 def load_predictor(
-    policy: str, env_id: str, env: gym.Env, env_kwargs: dict[str, Any] | None = None
+    policy: str,
+    env_id: str,
+    env: gym.Env,
+    env_kwargs: dict[str, Any] | None = None,
+    trust: bool = False,
 ) -> Any:
-    """A predictor from a scripted policy's name, a shipped model's name, or a path."""
+    """A predictor from a scripted policy's name, a shipped model's name, or a path
+    (``trust``: load a model folder that has no manifest)."""
     if policy in scripted_policies(env_id):
         kwargs = resolved_env_kwargs(env_id, env_kwargs)
         return make_policy(env_id, policy, env.observation_space, env.action_space, kwargs)
     shipped = pretrained_models(env_id)
     if policy in shipped:
-        verify_manifest(shipped[policy])
         return load_model(shipped[policy], env, env_id)
     path = Path(policy)
     if path.exists():
-        return load_model(path, env, env_id)
+        return load_model(path, env, env_id, trust)
     choices = ", ".join(available_policies(env_id)) or "none"
     raise UsageError(
         f"unknown policy {policy!r} for {env_id}: not one of the policies ({choices}) "

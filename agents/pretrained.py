@@ -2,8 +2,9 @@
 
 Layout: ``pretrained/<Name>-vN/<algo>/`` holds a run folder's ``model.zip``,
 ``config.yml``, ``command.txt``, ``metrics.json``, optionally
-``vecnormalize.pkl``, and ``manifest.json``: the SHA-256 of every other file.
-The manifest is checked before a model is used.
+``vecnormalize.npz``, and ``manifest.json``: the SHA-256 of every other file.
+The manifest is checked before a model is used. :mod:`motiongym.agents.ship`
+puts a run's model here.
 """
 
 from __future__ import annotations
@@ -17,6 +18,9 @@ from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 
 MANIFEST = "manifest.json"
+SHIPPED_FILES = ("model.zip", "vecnormalize.npz", "config.yml", "command.txt")
+METRICS = "metrics.json"
+LEARNING_CURVES = "learning_curves.csv"
 
 
 def pretrained_root() -> Path:
@@ -58,120 +62,3 @@ def pretrained_models(env_id: str) -> dict[str, Path]:
     return {
         folder.name: folder for folder in sorted(root.iterdir()) if (folder / "model.zip").is_file()
     }
-
-
-SHIPPED_FILES = ("model.zip", "vecnormalize.pkl", "config.yml", "command.txt")
-METRICS = "metrics.json"
-LEARNING_CURVES = "learning_curves.csv"
-
-
-def shipped_label(config: dict) -> str:
-    """The folder name of a run's model under its ID: the algorithm, ``-shared`` for a
-    shared-parameter multi-agent run (``vec_env: pettingzoo``)."""
-    return config["algo"] + ("-shared" if config.get("vec_env") == "pettingzoo" else "")
-
-
-def _run_config(run_dir: Path) -> dict:
-    import yaml
-
-    config_file = run_dir / "config.yml"
-    if not config_file.is_file():
-        raise UsageError(f"{run_dir} is not a training run folder (no config.yml)")
-    return yaml.safe_load(config_file.read_text())
-
-
-def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:
-    """``seed,steps,mean return,success rate`` per evaluation of the run's callback."""
-    import numpy as np
-
-    file = run_dir / "eval" / "evaluations.npz"
-    if not file.is_file():
-        return []
-    data = np.load(file)
-    returns = data["results"].mean(axis=1)
-    successes = (
-        data["successes"].mean(axis=1) if "successes" in data else [float("nan")] * len(returns)
-    )
-    return [
-        f"{seed},{int(steps)},{ret:.6g},{success:.6g}"
-        for steps, ret, success in zip(data["timesteps"], returns, successes, strict=True)
-    ]
-
-
-def ship(
-    run_dirs: list[Path], n_episodes: int = 20, seed: int | None = None, root: Path | None = None
-) -> Path:
-    """Evaluate the runs of one ID and algorithm (training seeds) and ship the best.
-
-    Every run is evaluated on the same ``n_episodes`` held-out seeds from
-    ``seed`` (default :data:`~motiongym.agents.evaluate.EVALUATION_SEED`, as
-    ``compare`` uses) in the registered task (training-only ``env_kwargs``
-    such as a curriculum's are not applied). The best run (success rate, then
-    mean return) is copied into ``pretrained/<Name>-vN/<label>/`` with
-    ``metrics.json``: each run's summary and episodes (and whether it acted on
-    its most likely or on sampled actions, its ``deterministic`` setting), and the summary pooled
-    over every run's episodes (the reported "over seeds and episodes"
-    figures); ``learning_curves.csv``: every run's evaluation-callback curve.
-    The manifest is written last.
-    """
-    import shutil
-
-    from motiongym.agents.environments import make_env
-    from motiongym.agents.evaluate import EVALUATION_SEED, Evaluation, evaluate
-    from motiongym.agents.predictors import load_model
-
-    if not run_dirs:
-        raise UsageError("ship needs at least one run folder")
-    configs = [_run_config(run_dir) for run_dir in run_dirs]
-    env_id, label = configs[0]["env_id"], shipped_label(configs[0])
-    for run_dir, config in zip(run_dirs, configs, strict=True):
-        if (config["env_id"], shipped_label(config)) != (env_id, label):
-            raise UsageError(
-                f"{run_dir} trained {shipped_label(config)} on {config['env_id']}, "
-                f"not {label} on {env_id}: ship the runs of one ID and algorithm together"
-            )
-    seed = EVALUATION_SEED if seed is None else seed
-    seeds = range(seed, seed + n_episodes)
-    env = make_env(env_id)
-    runs, pooled = [], Evaluation(env_id, label)
-    for run_dir, config in zip(run_dirs, configs, strict=True):
-        evaluation = evaluate(env, load_model(run_dir, env, env_id), seeds, env_id, label)
-        pooled.episodes += evaluation.episodes
-        runs.append(
-            {
-                "run": run_dir.name,
-                "training_seed": config["seed"],
-                "deterministic": config.get("deterministic", True),
-                **evaluation.to_json(),
-            }
-        )
-    env.close()
-
-    def score(run: dict) -> tuple[float, float]:
-        summary = run["summary"]
-        success = summary["is_success"]["mean"] if "is_success" in summary else 0.0
-        return success, summary["return"]["mean"]
-
-    best = max(range(len(runs)), key=lambda i: score(runs[i]))
-    folder = (root or pretrained_root()) / short_name(env_id) / label
-    if folder.is_dir():
-        shutil.rmtree(folder)
-    folder.mkdir(parents=True)
-    for name in SHIPPED_FILES:
-        if (run_dirs[best] / name).is_file():
-            shutil.copy2(run_dirs[best] / name, folder / name)
-    metrics = {
-        "env_id": env_id,
-        "policy": label,
-        "shipped_run": runs[best]["run"],
-        "held_out_seeds": list(seeds),
-        "pooled": pooled.summary(),
-        "runs": runs,
-    }
-    (folder / METRICS).write_text(json.dumps(metrics, indent=2))
-    rows = ["training_seed,timesteps,mean_return,success_rate"]
-    for run_dir, config in zip(run_dirs, configs, strict=True):
-        rows += _learning_curve_rows(run_dir, config["seed"])
-    (folder / LEARNING_CURVES).write_text("\n".join(rows) + "\n")
-    write_manifest(folder)
-    return folder

@@ -2,7 +2,10 @@
 
 A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 
-* ``model.zip``: the final model; ``vecnormalize.pkl`` if the run normalised;
+* ``model.zip``: the final model; ``vecnormalize.npz`` (plain arrays) if the
+  run normalised;
+* ``manifest.json``: the SHA-256 of every file above, written last (a folder
+  without it is refused by the loaders unless the user says ``--trust``);
 * ``config.yml``: the resolved block, with the ID, algorithm and seed;
 * ``command.txt``: the command that made the run;
 * ``eval/``: ``evaluations.npz`` and ``best_model.zip`` (SB3's EvalCallback),
@@ -52,13 +55,14 @@ from motiongym.agents.config import (
 from motiongym.agents.environments import check_env_id, importable_id, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
-from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
-from motiongym.agents.predictors import (
-    CONFIG_FILE,
-    MODEL_FILE,
+from motiongym.agents.model_files import (
     NORMALIZATION_FILE,
     algorithm_classes,
+    save_normalization,
 )
+from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
+from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE
+from motiongym.agents.pretrained import write_manifest
 from motiongym.agents.vector import VectorEnvAdapter
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
@@ -210,7 +214,7 @@ def train(
     )
     model.save(run_dir / MODEL_FILE)
     if isinstance(venv, VecNormalize):
-        venv.save(str(run_dir / NORMALIZATION_FILE))
+        save_normalization(venv, run_dir / NORMALIZATION_FILE)
     learning_curve_figure(
         eval_dir / "evaluations.npz",
         eval_dir / "learning_curve.png",
@@ -218,4 +222,5 @@ def train(
     )
     venv.close()
     eval_venv.close()
+    write_manifest(run_dir)
     return run_dir

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from motiongym.agents.pretrained import ship
+from motiongym.agents.ship import ship
 from motiongym.agents.train import train
 
 TINY_CONFIG = """

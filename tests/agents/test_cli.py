@@ -153,7 +153,11 @@ def test_model_for_another_space_is_refused(capsys, tmp_path):
     model_file = tmp_path / "cartpole.zip"
     PPO("MlpPolicy", "CartPole-v1", n_steps=32, batch_size=32, device="cpu").save(model_file)
     err = _error(capsys, ["evaluate", SWEEPER, "--policy", str(model_file)])
-    assert "another observation space" in err
+    assert "no manifest.json" in err and "--trust" in err
+    assert main(["evaluate", SWEEPER, "--policy", str(model_file), "--trust"]) == 2
+    warning, err = capsys.readouterr().err.strip().split("\n")
+    assert warning.startswith("warning: ") and "without a manifest" in warning
+    assert err.startswith("motiongym: error: ") and "another observation space" in err
 
 
 def test_no_traceback_from_the_installed_command(tmp_path):

@@ -179,7 +179,7 @@ def test_tiny_shared_run_loads_as_a_predictor_of_the_single_agent_view(tmp_path)
     config.write_text(SHARED_CONFIG)
     run_dir = train(DUAL_ARM, "ppo", config_path=config, out_root=tmp_path, progress=False)
     assert yaml.safe_load((run_dir / "config.yml").read_text())["vec_env"] == "pettingzoo"
-    assert (run_dir / "vecnormalize.pkl").is_file()
+    assert (run_dir / "vecnormalize.npz").is_file()
     assert (run_dir / "eval" / "evaluations.npz").is_file()
     monitor = (run_dir / "monitor" / "pettingzoo.monitor.csv").read_text().splitlines()
     assert len(monitor) > 2  # episodes of at most 40 steps, one row per slot

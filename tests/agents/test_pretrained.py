@@ -12,7 +12,8 @@ from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
 from motiongym.agents.predictors import load_predictor
-from motiongym.agents.pretrained import pretrained_models, ship, verify_manifest
+from motiongym.agents.pretrained import pretrained_models, verify_manifest
+from motiongym.agents.ship import ship
 from motiongym.envs import ENV_IDS
 
 SHIPPED = [(env_id, name) for env_id in ENV_IDS for name in pretrained_models(env_id)]
@@ -30,7 +31,7 @@ def test_shipped_model_verifies_loads_and_runs_an_episode(env_id, name):
 def test_ship_writes_metrics_and_a_manifest_that_detects_tampering(shipped_folder, tmp_path):
     for name in (
         "model.zip",
-        "vecnormalize.pkl",
+        "vecnormalize.npz",
         "config.yml",
         "command.txt",
         "metrics.json",

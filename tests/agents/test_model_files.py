@@ -1,0 +1,140 @@
+"""Model folders from anyone: nothing in them runs, bad statistics are refused.
+
+Planted payloads only ``echo`` into a file under the test's temporary folder;
+every test asserts that the file never appears.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import os
+import pickle
+import shutil
+import zipfile
+
+import numpy as np
+import pytest
+
+from motiongym.agents.environments import make_env
+from motiongym.agents.errors import UsageError
+from motiongym.agents.model_files import NORMALIZATION_FILE
+from motiongym.agents.predictors import load_predictor
+from motiongym.agents.pretrained import pretrained_models, write_manifest
+
+ENV_ID = "motiongym/HarvestArm-v0"
+
+
+class Payload:
+    def __init__(self, marker):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (os.system, (f"echo pwned > {self.marker}",))
+
+
+@pytest.fixture
+def folder(tmp_path):
+    copy = tmp_path / "run"
+    shutil.copytree(pretrained_models(ENV_ID)["ppo"], copy)
+    return copy
+
+
+def _load(path, trust=False):
+    env = make_env(ENV_ID)
+    return load_predictor(str(path), ENV_ID, env, trust=trust)
+
+
+def test_a_shipped_model_copied_with_its_manifest_loads_and_acts(folder):
+    predictor = _load(folder)
+    env = make_env(ENV_ID)
+    observation, _ = env.reset(seed=0)
+    action, _ = predictor.predict(observation)
+    assert env.action_space.contains(action.astype(np.float32))
+
+
+def test_a_planted_vecnormalize_pickle_is_never_read(folder, tmp_path):
+    marker = tmp_path / "marker"
+    (folder / NORMALIZATION_FILE).unlink()
+    (folder / "vecnormalize.pkl").write_bytes(pickle.dumps(Payload(marker)))
+    write_manifest(folder)  # an attacker writes a matching manifest too
+    with pytest.raises(UsageError, match="pickle"):
+        _load(folder)
+    assert not marker.exists()
+
+
+def test_an_extra_serialized_entry_in_the_archive_is_refused_by_name(folder, tmp_path):
+    marker = tmp_path / "marker"
+    archive = folder / "model.zip"
+    with zipfile.ZipFile(archive) as z:
+        members = {name: z.read(name) for name in z.namelist()}
+    data = json.loads(members["data"])
+    blob = base64.b64encode(pickle.dumps(Payload(marker))).decode()
+    data["innocent"] = {":type:": "<class 'object'>", ":serialized:": blob}
+    members["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(archive, "w") as z:
+        for name, content in members.items():
+            z.writestr(name, content)
+    write_manifest(folder)
+    with pytest.raises(UsageError, match="innocent"):
+        _load(folder)
+    assert not marker.exists()
+
+
+def test_a_replaced_serialized_policy_class_is_never_unpickled(folder, tmp_path):
+    marker = tmp_path / "marker"
+    archive = folder / "model.zip"
+    with zipfile.ZipFile(archive) as z:
+        members = {name: z.read(name) for name in z.namelist()}
+    data = json.loads(members["data"])
+    data["policy_class"][":serialized:"] = base64.b64encode(pickle.dumps(Payload(marker))).decode()
+    members["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(archive, "w") as z:
+        for name, content in members.items():
+            z.writestr(name, content)
+    write_manifest(folder)
+    _load(folder)  # the class is identified from its plain-text module and docstring
+    assert not marker.exists()
+
+
+def test_an_unknown_archive_member_is_refused(folder):
+    with zipfile.ZipFile(folder / "model.zip", "a") as z:
+        z.writestr("extra.pkl", b"anything")
+    write_manifest(folder)
+    with pytest.raises(UsageError, match="extra.pkl"):
+        _load(folder)
+
+
+def test_a_folder_without_manifest_needs_trust_and_warns(folder, capsys):
+    (folder / "manifest.json").unlink()
+    with pytest.raises(UsageError, match="--trust"):
+        _load(folder)
+    _load(folder, trust=True)
+    assert "without a manifest" in capsys.readouterr().err
+
+
+def test_a_flipped_byte_in_the_statistics_is_caught(folder):
+    path = folder / NORMALIZATION_FILE
+    with np.load(path) as file:
+        arrays = {name: file[name] for name in file.files}
+    arrays["mean"] = arrays["mean"].copy()
+    arrays["mean"][3] = 1.6e308  # a flipped exponent byte of 0.884
+    np.savez(path, **arrays)
+    with pytest.raises(UsageError, match="SHA-256"):
+        _load(folder)  # the manifest sees it first
+    (folder / "manifest.json").unlink()
+    with pytest.raises(UsageError, match="mean\\[3\\]"):
+        _load(folder, trust=True)  # and the statistics' own check without it
+    arrays["var"] = arrays["var"].copy()
+    arrays["mean"][3], arrays["var"][0] = 0.0, float("nan")
+    np.savez(path, **arrays)
+    with pytest.raises(UsageError, match="not finite"):
+        _load(folder, trust=True)
+
+
+def test_a_truncated_archive_is_one_clear_error(folder):
+    archive = folder / "model.zip"
+    archive.write_bytes(archive.read_bytes()[:500])
+    (folder / "manifest.json").unlink()
+    with pytest.raises(UsageError, match="not a Stable-Baselines3 model"):
+        _load(folder, trust=True)
