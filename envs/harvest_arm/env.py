@@ -10,6 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
+from motiongym.envs.core import check_bool
 from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec, build_model
 from motiongym.envs.harvest_arm.observation import DISTANCE_CLIP, ObservationLayout
 from motiongym.envs.harvest_arm.task import (
@@ -75,14 +76,24 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
 
     ``info``: ``distance_to_fruit`` (m), ``min_distance`` (smallest
     link-obstacle clearance this step, m), ``min_distance_so_far`` (m),
-    ``close_approach`` (d_min < safety_distance), ``cost`` (1.0 then),
-    ``collision``, ``is_success``, ``reward_<term>``.
+    ``close_approach`` (d_min < safety_distance), ``collision`` (d_min <= 0,
+    or with ``self_collision`` two non-adjacent links touching), ``cost``
+    (1.0 on a close approach or a collision), ``is_success``,
+    ``reward_<term>``; with ``self_collision`` also ``self_distance`` (m,
+    smallest surface distance between two links that share no joint point,
+    clipped at 1 m) and ``self_collision`` (it is <= 0).
 
     Reset options: ``fruit`` (dim,) and ``obstacles`` (list of
     ``{"center", "radius"}`` or ``{"a", "b", "radius"}``) together give an
     explicit scene; ``q`` (n,) a start pose (default the arm's home pose).
 
-    Version history: v0 (initial).
+    Version history:
+
+    * v1: ``self_collision=True``: two non-adjacent links touching is a
+      collision (``info["collision"]``, the cost, the collision reward term and,
+      with ``terminate_on_collision``, termination), measured by MuJoCo on
+      explicit link-link pairs. Observation and scenes as v0.
+    * v0 (initial): only link-obstacle contact is a collision.
     """
 
     metadata = {
@@ -109,6 +120,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         safety_distance: float = 0.03,  # m, the paper's collision-risk distance
         success_tolerance: float = 0.02,  # m, gripper to fruit centre
         terminate_on_collision: bool = True,
+        self_collision: bool = False,
         progress: float = 10.0,
         clearance: float = 1.0,
         collision: float = 10.0,
@@ -142,8 +154,14 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         }
         self.render_mode, self.width, self.height = render_mode, width, height
 
+        self.self_collision = check_bool("self_collision", self_collision)
         self.model, self.index = build_model(
-            self.spec_arm, self.link_radius, n_obstacles - n_bars, n_bars, self.dt
+            self.spec_arm,
+            self.link_radius,
+            n_obstacles - n_bars,
+            n_bars,
+            self.dt,
+            self_pairs=self.self_collision,
         )
         self.data = mujoco.MjData(self.model)
         self.kinematics = ArmKinematics(self.spec_arm, self.link_radius, self.dt)
@@ -158,13 +176,20 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
         self._action_shape = (n,)
-        # contact (geom1, geom2) -> flat index into the (L, K) clearance matrix
+        # contact (geom1, geom2) -> flat index into the (L, K) clearance matrix, then
+        # the self pairs
         links, obstacles = self.index["link_geoms"], self.index["obstacle_geoms"]
         self._pair_slot = np.zeros((self.model.ngeom, self.model.ngeom), dtype=np.int64)
         for li, lg in enumerate(links):
             for k, og in enumerate(obstacles):
                 self._pair_slot[lg, og] = self._pair_slot[og, lg] = li * n_obstacles + k
-        self._clear = np.full(len(links) * n_obstacles, DISTANCE_CLIP)  # (L*K,)
+        self._n_lk = len(links) * n_obstacles
+        for s_, (i, j) in enumerate(self.index["self_pairs"]):
+            gi, gj = links[i], links[j]
+            self._pair_slot[gi, gj] = self._pair_slot[gj, gi] = self._n_lk + s_
+        self._n_self = len(self.index["self_pairs"])
+        self._clear = np.full(self._n_lk + self._n_self, DISTANCE_CLIP)  # (L*K + S,)
+        self._self_d = DISTANCE_CLIP
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
         self._sites = self.index["point_sites"]
         self._s_sin, self._s_cos = self._slices["sin_q"], self._slices["cos_q"]
@@ -247,7 +272,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         m.geom_pos[self.index["fruit_geom"][0]] = fruit3
         m.geom_size[self.index["fruit_geom"][0]] = (FRUIT_RADIUS, 0.0, 0.0)
         self.scene = scene
-        self._n_pairs = len(self.index["link_geoms"]) * len(scene)
+        self._n_pairs = len(self.index["link_geoms"]) * len(scene) + self._n_self
         self._slots: np.ndarray | None = None  # contact order -> clearance slot, set once
         s = self._slices
         self._obs[s["fruit"]] = scene.fruit
@@ -268,7 +293,7 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         d_fruit = self._distance_to_fruit()
         min_d = self._min_d
         self._min_so_far = min(self._min_so_far, min_d)
-        collided = min_d <= 0.0
+        collided = min_d <= 0.0 or self._self_d <= 0.0
         arrived = d_fruit <= self.success_tolerance
         w = self.weights
         terms = {
@@ -306,14 +331,18 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
                 clear[slots] = np.minimum(dist, DISTANCE_CLIP)
             else:  # a pair with two contacts (parallel capsules): keep the smaller
                 np.minimum.at(clear, slots, dist)
-        self._min_d = float(clear.min())
+        if self._n_self:
+            self._min_d = float(clear[: self._n_lk].min())
+            self._self_d = float(clear[self._n_lk :].min())
+        else:
+            self._min_d = float(clear.min())
         obs[self._s_sin] = np.sin(q)
         obs[self._s_cos] = np.cos(q)
         obs[self._s_qdot] = qdot
         points = d.site_xpos[self._sites, : self.dim]
         obs[self._s_points] = points.ravel()
         obs[self._s_fruit_error] = self._fruit - points[-1]
-        obs[self._s_dist] = clear
+        obs[self._s_dist] = clear[: self._n_lk]
         self._gripper = points[-1]
 
     def _distance_to_fruit(self) -> float:
@@ -331,6 +360,9 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
             "cost": 1.0 if close or collided else 0.0,
             "is_success": bool(arrived),
         }
+        if self._n_self:
+            info["self_distance"] = self._self_d
+            info["self_collision"] = bool(self._self_d <= 0.0)
         for key, value in terms.items():
             info[f"reward_{key}"] = float(value)
         return info

@@ -141,6 +141,7 @@ def build_model(
     n_spheres: int,
     n_bars: int,
     dt: float,
+    self_pairs: bool = False,
 ) -> tuple[mujoco.MjModel, dict[str, np.ndarray]]:
     """The MuJoCo model: arm bodies, link capsules, obstacle slots, the fruit.
 
@@ -149,10 +150,14 @@ def build_model(
     5 m margin, so ``mj_collision`` reports the exact signed distance of every
     pair each step (MuJoCo's analytic sphere-capsule and capsule-capsule
     tests) while nothing moves under contact forces (the arm is kinematic).
+    ``self_pairs`` adds, after those, one pair per two non-adjacent links
+    (no shared joint point) with the same margin: their signed distances
+    measure self-collision.
 
     Returns:
         the compiled model and index arrays: ``link_geoms`` (L,),
-        ``obstacle_geoms`` (K,), ``point_sites`` (P,), ``fruit_geom`` (1,).
+        ``obstacle_geoms`` (K,), ``point_sites`` (P,), ``fruit_geom`` (1,),
+        ``self_pairs`` (S, 2) link indices of the self pairs (S = 0 without).
     """
     s = mujoco.MjSpec()
     s.modelname = f"harvest_{spec.name}"
@@ -240,6 +245,10 @@ def build_model(
     for link in link_geoms:
         for obstacle in obstacle_geoms:
             s.add_pair(geomname1=link, geomname2=obstacle, margin=5.0)
+    n_links = len(link_geoms)
+    pairs = [(i, j) for i in range(n_links) for j in range(i + 2, n_links)] if self_pairs else []
+    for i, j in pairs:
+        s.add_pair(geomname1=link_geoms[i], geomname2=link_geoms[j], margin=5.0)
     model = s.compile()
     for name in obstacle_geoms:  # moved and turned at reset: never assume the body's frame
         model.geom_sameframe[model.geom(name).id] = mujoco.mjtSameFrame.mjSAMEFRAME_NONE
@@ -248,6 +257,7 @@ def build_model(
         "obstacle_geoms": np.array([model.geom(g).id for g in obstacle_geoms], dtype=int),
         "point_sites": np.array([model.site(p).id for p in point_sites]),
         "fruit_geom": np.array([model.geom("fruit").id]),
+        "self_pairs": np.array(pairs, dtype=int).reshape(-1, 2),
     }
     return model, index
 

@@ -204,3 +204,53 @@ def test_render_rgb_array_shows_the_scene():
     assert frame.shape == (120, 160, 3)
     assert frame.std() > 5
     env.close()
+
+
+@pytest.mark.parametrize(("planar", "dof"), ARMS)
+def test_v1_self_distance_is_the_brute_force_distance_of_non_adjacent_links(planar, dof):
+    """MuJoCo's link-link pairs against segment distances of our own joint points."""
+    env_id = "motiongym/HarvestArmPlanar-v1" if planar else "motiongym/HarvestArm-v1"
+    env = gym.make(env_id, dof=dof, terminate_on_collision=False)
+    base = env.unwrapped
+    kin = ArmKinematics(base.spec_arm)
+    rng = np.random.default_rng(dof + 10 * planar)
+    limits = base.spec_arm.limits
+    r = base.link_radius
+    seen_collision = seen_clear = 0
+    for _ in range(60):
+        q = rng.uniform(-limits, limits)
+        _, info = env.reset(seed=1, options={"q": q})
+        _, _, _, _, info = env.step(np.zeros(dof, dtype=np.float32))
+        points = kin.forward(q)
+        p0, p1 = points[:-1], points[1:]
+        brute = min(
+            float(closest_points_between_segments(p0[i], p1[i], p0[j], p1[j])[0]) - 2 * r
+            for i in range(len(p0))
+            for j in range(i + 2, len(p0))
+        )
+        assert info["self_distance"] == pytest.approx(min(brute, 1.0), abs=1e-6)
+        assert info["self_collision"] == (brute <= 0.0)
+        if brute <= 0.0:
+            seen_collision += 1
+            assert info["collision"] and info["cost"] == 1.0
+            assert info["reward_collision"] == -base.weights["collision"]
+        else:
+            seen_clear += 1
+    assert seen_clear > 0
+    if planar:  # random planar poses fold the arm onto itself often
+        assert seen_collision > 0
+
+
+def test_v1_terminates_on_self_collision_and_v0_ignores_it():
+    """A planar 5-DOF arm folded back onto itself, no obstacle near."""
+    q = np.array([0.0, 2.6, 2.6, 2.6, 0.0])
+    far = [{"center": [0.8, 0.5], "radius": 0.01}]
+    options = {"q": q, "fruit": np.array([0.5, -0.4]), "obstacles": far}
+    v1 = gym.make("motiongym/HarvestArmPlanar-v1")
+    v1.reset(seed=0, options=options)
+    _, _, terminated, _, info = v1.step(np.zeros(5, dtype=np.float32))
+    assert info["self_collision"] and info["collision"] and terminated
+    v0 = gym.make("motiongym/HarvestArmPlanar-v0")
+    v0.reset(seed=0, options=options)
+    _, _, terminated, _, info = v0.step(np.zeros(5, dtype=np.float32))
+    assert not info["collision"] and not terminated and "self_collision" not in info
