@@ -3,17 +3,21 @@
 ``potential-field`` (:class:`PotentialFieldPolicy`), the paper's method:
 
 1. at the episode's first step, plan the gripper's safe path from its start
-   to the fruit with the potential field (eq. 2-7, RK4,
-   :mod:`.potential_field`; after a stall in a local minimum, our escape
-   stands in for the paper's undescribed "virtual plane");
+   to the fruit with the potential field (eq. 2-7, RK4, the obstacle terms
+   in the virtual plane normal to the way to the fruit,
+   :mod:`.potential_field`);
 2. every step, the gripper's velocity ``X_dot`` follows that path (aim at the
    path point one control period ahead of the nearest one, at most
    ``|V_end_ref|``; past the path's end, straight at the fruit); the joint
-   points' reference velocities combine trajectory following with the
-   avoidance of point and bar obstacles (eq. 8-11, :mod:`.reference_velocity`);
+   points follow the leader (eq. 8) and every link point near an obstacle
+   is pushed off it (eq. 9-11, :mod:`.reference_velocity`);
 3. the joint rates are eq. 1's weighted pseudo-inverse with the null-space
-   term, within joint ranges and speed limits (:mod:`.redundancy`), all
-   weights ``k_i = 1``.
+   term, within joint ranges and speed limits (:mod:`.redundancy`), weights
+   ``k_i = 1`` for the joint points and ``1 + |w_ob|`` for the link points.
+
+``potential-field-extended`` (:class:`ExtendedPotentialFieldPolicy`): the
+same plus our "vortex" escape from a local minimum of the path (not the
+paper's; :func:`.potential_field.plan_path`).
 
 ``resolved-rate`` (:class:`ResolvedRatePolicy`): the gripper straight at the
 fruit at ``|V_end_ref|``, joint rates by the ordinary pseudo-inverse of the
@@ -38,9 +42,10 @@ from motiongym.baselines.harvest_arm.reference_velocity import (
     link_avoidance,
 )
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.core import check_bool
-from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec
+from motiongym.envs.core import check_bool, params_from_kwargs
+from motiongym.envs.harvest_arm.model import ArmKinematics
 from motiongym.envs.harvest_arm.observation import ObservationLayout
+from motiongym.envs.harvest_arm.params import HarvestArmParams
 
 GRIPPER_SPEED = 0.2  # m/s, |V_end_ref| (the paper does not give it) and every |V_i_ref|
 JOINT_DAMPING = 1e-3  # eq. 1's S1 + JOINT_DAMPING trace(S1)/n I: a small cost on joint rates
@@ -59,13 +64,11 @@ class _ArmPolicy(ScriptedPolicy):
         env_kwargs: dict[str, Any] | None = None,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
-        kw = self.env_kwargs
-        planar = bool(kw.get("planar", False))
-        self.arm = arm_spec(int(kw.get("dof") or (5 if planar else 7)), planar)
-        self.link_radius = float(kw.get("link_radius", 0.02))
-        self.dt = float(kw.get("dt", 0.05))
+        params = params_from_kwargs(HarvestArmParams, self.env_kwargs, ignore=("render_mode",))
+        self.arm = params.arm
+        self.link_radius, self.dt = params.link_radius, params.dt
         self.kin = ArmKinematics(self.arm, self.link_radius, self.dt)
-        n_slots = int(kw.get("n_obstacles") or (8 if planar else 10))
+        n_slots = params.n_obstacles
         self.layout = ObservationLayout(self.arm.dof, self.arm.dim, self.kin.n_points, n_slots)
         if observation_space.shape != (self.layout.size,):
             raise ValueError(

@@ -10,21 +10,28 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
-from motiongym.envs.core import check_bool
-from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec, build_model
-from motiongym.envs.harvest_arm.observation import DISTANCE_CLIP, ObservationLayout
+from motiongym.envs.core import (
+    ArgumentError,
+    NeedsReset,
+    check_options,
+    check_render_mode,
+    check_shape,
+    reward_and_info,
+    zero_terms,
+)
+from motiongym.envs.harvest_arm.observation import ObservationLayout
+from motiongym.envs.harvest_arm.params import HarvestArmParams
 from motiongym.envs.harvest_arm.task import (
-    FRUIT_RADIUS,
     Scene,
+    check_position,
     sample_scene,
     scene_from_obstacles,
 )
+from motiongym.envs.harvest_arm.world import HarvestArmWorld
 from motiongym.envs.rendering import OwnsRenderer
 
-_RESET_OPTIONS = ("fruit", "obstacles", "q")
 
-
-class HarvestArmEnv(OwnsRenderer, gym.Env):
+class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
     """Bring a redundant arm's gripper to a fruit while its links keep clear.
 
     The arm of Ryu et al. (fruit-harvesting redundant robot) among immature
@@ -83,9 +90,18 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
     smallest surface distance between two links that share no joint point,
     clipped at 1 m) and ``self_collision`` (it is <= 0).
 
-    Reset options: ``fruit`` (dim,) and ``obstacles`` (list of
-    ``{"center", "radius"}`` or ``{"a", "b", "radius"}``) together give an
-    explicit scene; ``q`` (n,) a start pose (default the arm's home pose).
+    Keyword arguments and their limits: :class:`HarvestArmParams` (one
+    frozen dataclass that the scripted policies build too).
+
+    Reset options (validated; an :class:`~motiongym.envs.core.ArgumentError`
+    names the option otherwise): ``fruit`` (dim,) and ``obstacles`` (list of
+    ``{"center", "radius"}`` or ``{"a", "b", "radius"}``, finite coordinates
+    within +-2 m, radius in (0, 0.2] m, at most the env's sphere and bar
+    slots) together give an explicit scene; an obstacle that overlaps the
+    fruit sphere is refused. ``q`` (n,) a finite start pose (default the
+    arm's home pose), clipped to the joint ranges. A fruit out of the arm's
+    reach is accepted: the episode runs until the time limit (truncation)
+    with ``is_success`` False.
 
     Version history:
 
@@ -131,174 +147,98 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         width: int = 480,
         height: int = 360,
     ) -> None:
-        dof = (5 if planar else 7) if dof is None else int(dof)
-        self.spec_arm = arm_spec(dof, bool(planar))
-        n_obstacles = (8 if planar else 10) if n_obstacles is None else int(n_obstacles)
-        n_bars = (0 if planar else 3) if n_bars is None else int(n_bars)
-        if not 0 <= n_bars <= n_obstacles:
-            raise ValueError(f"n_bars must be in [0, n_obstacles={n_obstacles}], got {n_bars}")
-        if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
-        self.n_obstacles, self.n_bars = n_obstacles, n_bars
-        self.link_radius, self.dt = float(link_radius), float(dt)
-        self.safety_distance = float(safety_distance)
-        self.success_tolerance = float(success_tolerance)
-        self.terminate_on_collision = bool(terminate_on_collision)
-        self.weights = {
-            "progress": progress,
-            "clearance": clearance,
-            "collision": collision,
-            "effort": effort,
-            "success": success,
-            "distance": distance,
-        }
-        self.render_mode, self.width, self.height = render_mode, width, height
-
-        self.self_collision = check_bool("self_collision", self_collision)
-        self.model, self.index = build_model(
-            self.spec_arm,
-            self.link_radius,
-            n_obstacles - n_bars,
-            n_bars,
-            self.dt,
-            self_pairs=self.self_collision,
-        )
-        self.data = mujoco.MjData(self.model)
-        self.kinematics = ArmKinematics(self.spec_arm, self.link_radius, self.dt)
+        p = HarvestArmParams(
+            dof, planar, n_obstacles, n_bars, link_radius, dt, safety_distance,
+            success_tolerance, terminate_on_collision, self_collision, progress, clearance,
+            collision, effort, success, distance, width, height,
+        )  # fmt: skip
+        self.params = p
+        self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
+        self.world = HarvestArmWorld(p)
+        self.spec_arm, self.kinematics = self.world.arm, self.world.kinematics
+        self.n_obstacles, self.n_bars = p.n_obstacles, p.n_bars
+        self.link_radius, self.dt = p.link_radius, p.dt
+        self.weights = p.weights
         n, self.dim = self.spec_arm.dof, self.spec_arm.dim
-        self.layout = ObservationLayout(n, self.dim, len(self.index["point_sites"]), n_obstacles)
-        self._slices = self.layout.slices
+        self.layout = ObservationLayout(n, self.dim, self.world.n_points, p.n_obstacles)
         self._limits = self.spec_arm.limits
-        self._low = -self._limits
-        self._speeds = self.spec_arm.speeds
-        self._step_size = self._speeds * self.dt  # rad per unit action
-        low, high = self.layout.bounds(self._speeds)
+        self._step_size = self.spec_arm.speeds * p.dt  # rad per unit action
+        low, high = self.layout.bounds(self.spec_arm.speeds)
         self.observation_space = spaces.Box(low, high, dtype=np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
-        self._action_shape = (n,)
-        # contact (geom1, geom2) -> flat index into the (L, K) clearance matrix, then
-        # the self pairs
-        links, obstacles = self.index["link_geoms"], self.index["obstacle_geoms"]
-        self._pair_slot = np.zeros((self.model.ngeom, self.model.ngeom), dtype=np.int64)
-        for li, lg in enumerate(links):
-            for k, og in enumerate(obstacles):
-                self._pair_slot[lg, og] = self._pair_slot[og, lg] = li * n_obstacles + k
-        self._n_lk = len(links) * n_obstacles
-        for s_, (i, j) in enumerate(self.index["self_pairs"]):
-            gi, gj = links[i], links[j]
-            self._pair_slot[gi, gj] = self._pair_slot[gj, gi] = self._n_lk + s_
-        self._n_self = len(self.index["self_pairs"])
-        self._clear = np.full(self._n_lk + self._n_self, DISTANCE_CLIP)  # (L*K + S,)
-        self._self_d = DISTANCE_CLIP
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
-        self._sites = self.index["point_sites"]
-        self._s_sin, self._s_cos = self._slices["sin_q"], self._slices["cos_q"]
-        self._s_qdot, self._s_points = self._slices["qdot"], self._slices["points"]
-        self._s_dist = self._slices["distances"]
-        self._s_fruit_error = self._slices["fruit_error"]
+        s = self.layout.slices
+        self._s_sin, self._s_cos, self._s_qdot = s["sin_q"], s["cos_q"], s["qdot"]
+        self._s_points, self._s_dist = s["points"], s["distances"]
+        self._s_fruit_error = s["fruit_error"]
         self._q = np.zeros(n)
         self._renderer: mujoco.Renderer | None = None
         self._path: list[np.ndarray] = []
-        self.scene: Scene | None = None
+        self._was_reset = False
+
+    @property
+    def scene(self) -> Scene | None:
+        """The current scene (None before the first reset)."""
+        return self.world.scene
 
     # ------------------------------------------------------------------ reset
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
-        options = dict(options or {})
-        unknown = set(options) - set(_RESET_OPTIONS)
-        if unknown:
-            raise ValueError(f"unknown reset options {sorted(unknown)}; valid: {_RESET_OPTIONS}")
+        n = self.spec_arm.dof
+        options = check_options(
+            options,
+            {
+                "fruit": lambda name, v: check_position(name, v, self.dim),
+                "obstacles": lambda name, v: v,  # checked with the fruit, below
+                "q": lambda name, v: check_shape(name, v, (n,)),
+            },
+        )
         if ("fruit" in options) != ("obstacles" in options):
-            raise ValueError("reset options 'fruit' and 'obstacles' must be given together")
+            raise ArgumentError("reset options 'fruit' and 'obstacles' must be given together")
         if "fruit" in options:
-            scene = scene_from_obstacles(options["fruit"], options["obstacles"], self.dim)
-            n_bar = int(scene.is_bar.sum())
-            if n_bar > self.n_bars or len(scene) - n_bar > self.n_obstacles - self.n_bars:
-                raise ValueError(
-                    f"explicit scene has {len(scene) - n_bar} spheres and {n_bar} bars; this env "
-                    f"has {self.n_obstacles - self.n_bars} sphere and {self.n_bars} bar slots"
-                )
+            scene = scene_from_obstacles(
+                options["fruit"], options["obstacles"], self.dim,
+                (self.n_obstacles - self.n_bars, self.n_bars),
+            )  # fmt: skip
         else:
             scene = sample_scene(
                 self.np_random, self.kinematics, self.n_obstacles, self.n_bars, self.link_radius
             )
-        q = np.array(options.get("q", self.spec_arm.home), float).reshape(-1)
-        if q.shape != (self.spec_arm.dof,):
-            raise ValueError(f"option 'q' must have shape ({self.spec_arm.dof},), got {q.shape}")
-        self._set_scene(scene)
-        self._q = np.clip(q, -self._limits, self._limits)
-        self._update(np.zeros(self.spec_arm.dof))
-        self._d_fruit = self._distance_to_fruit()
-        self._min_so_far = self._min_d
-        self._path = [self.data.site_xpos[self.index["point_sites"][-1]].copy()]
-        info = self._info(False, False, {k: 0.0 for k in self.weights})
-        return self._obs.copy(), info
-
-    def _set_scene(self, scene: Scene) -> None:
-        """Move the obstacle slots (spheres first, then bars) and the fruit."""
-        m, dim, slots = self.model, self.dim, self.index["obstacle_geoms"]
-        n_sphere_slots = self.n_obstacles - self.n_bars
-        order = np.concatenate([np.flatnonzero(~scene.is_bar), np.flatnonzero(scene.is_bar)])
-        sphere_ids = list(range(int((~scene.is_bar).sum())))
-        bar_ids = list(range(n_sphere_slots, n_sphere_slots + int(scene.is_bar.sum())))
-        placed = dict(zip(sphere_ids + bar_ids, order, strict=True))
-        obstacles = np.zeros((self.n_obstacles, self.layout.obstacle_width))
-        mask = np.zeros(self.n_obstacles)
-        for slot, g in enumerate(slots):
-            if slot not in placed:
-                m.geom_pos[g] = (0.0, 0.0, -100.0)
-                continue
-            k = placed[slot]
-            a3, b3 = np.zeros(3), np.zeros(3)
-            a3[:dim], b3[:dim] = scene.a[k], scene.b[k]
-            r = scene.radius[k]
-            m.geom_pos[g] = 0.5 * (a3 + b3)
-            if scene.is_bar[k]:
-                half = 0.5 * np.linalg.norm(b3 - a3)
-                m.geom_size[g] = (r, max(half, 1e-6), 0.0)
-                quat = np.zeros(4)
-                mujoco.mju_quatZ2Vec(quat, b3 - a3)
-                m.geom_quat[g] = quat
-                m.geom_rbound[g] = r + half
-            else:
-                m.geom_size[g] = (r, 0.0, 0.0)
-                m.geom_rbound[g] = r
-            obstacles[slot] = [*scene.a[k], *scene.b[k], r, float(scene.is_bar[k])]
-            mask[slot] = 1.0
-        fruit3 = np.zeros(3)
-        fruit3[:dim] = scene.fruit
-        m.geom_pos[self.index["fruit_geom"][0]] = fruit3
-        m.geom_size[self.index["fruit_geom"][0]] = (FRUIT_RADIUS, 0.0, 0.0)
-        self.scene = scene
-        self._n_pairs = len(self.index["link_geoms"]) * len(scene) + self._n_self
-        self._slots: np.ndarray | None = None  # contact order -> clearance slot, set once
-        s = self._slices
+        q = options.get("q", np.array(self.spec_arm.home, float))
+        rows, mask = self.world.set_scene(scene, self.layout.obstacle_width)
+        s = self.layout.slices
         self._obs[s["fruit"]] = scene.fruit
-        self._obs[s["obstacles"]] = obstacles.ravel()
+        self._obs[s["obstacles"]] = rows.ravel()
         self._obs[s["mask"]] = mask
         self._fruit = scene.fruit.copy()
+        self._q = np.clip(q, -self._limits, self._limits)
+        self._update(np.zeros(n))
+        self._d_fruit = self._distance_to_fruit()
+        self._min_so_far = self.world.min_distance
+        self._path = [self.world.gripper_3d()]
+        self._was_reset = True
+        return self._obs.copy(), self._info(False, False, zero_terms(self.weights))
 
     # ------------------------------------------------------------------- step
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        a = checked_box_action(action, self._action_shape, "one rate per joint")
-        if self.scene is None:
-            raise RuntimeError("call reset() before step()")
+        a = checked_box_action(action, self.action_space.shape, "one rate per joint")
+        self._require_reset("step")
         a = np.minimum(np.maximum(a, -1.0), 1.0)
         q_old = self._q
         q = q_old + a * self._step_size  # rad
-        self._q = np.minimum(np.maximum(q, self._low), self._limits)
+        self._q = np.minimum(np.maximum(q, -self._limits), self._limits)
         self._update((self._q - q_old) / self.dt)
         d_fruit = self._distance_to_fruit()
-        min_d = self._min_d
+        min_d = self.world.min_distance
         self._min_so_far = min(self._min_so_far, min_d)
-        collided = min_d <= 0.0 or self._self_d <= 0.0
-        arrived = d_fruit <= self.success_tolerance
+        collided = min_d <= 0.0 or self.world.self_distance <= 0.0
+        arrived = d_fruit <= self.params.success_tolerance
         w = self.weights
         terms = {
             "progress": w["progress"] * (self._d_fruit - d_fruit),
-            "clearance": -w["clearance"] * max(0.0, 1.0 - min_d / self.safety_distance),
+            "clearance": -w["clearance"] * max(0.0, 1.0 - min_d / self.params.safety_distance),
             "collision": -w["collision"] * float(collided),
             "effort": -w["effort"] * float(np.dot(a, a)) / len(a),
             "success": w["success"] * float(arrived),
@@ -306,94 +246,57 @@ class HarvestArmEnv(OwnsRenderer, gym.Env):
         }
         self._d_fruit = d_fruit
         if self.render_mode is not None:
-            self._path.append(self.data.site_xpos[self.index["point_sites"][-1]].copy())
-        terminated = bool(arrived or (collided and self.terminate_on_collision))
-        info = self._info(arrived, collided, terms)
-        return self._obs.copy(), float(sum(terms.values())), terminated, False, info
+            self._path.append(self.world.gripper_3d())
+        terminated = bool(arrived or (collided and self.params.terminate_on_collision))
+        reward, info = self._reward_and_info(arrived, collided, terms)
+        return self._obs.copy(), reward, terminated, False, info
 
     def _update(self, qdot: np.ndarray) -> None:
-        """Pose, clearances and the per-step part of the observation."""
-        d, obs, q = self.data, self._obs, self._q
-        d.qpos[:] = q
-        mujoco.mj_kinematics(self.model, d)
-        mujoco.mj_collision(self.model, d)
-        clear = self._clear
-        clear.fill(DISTANCE_CLIP)
-        if d.ncon == self._n_pairs and self._slots is not None:
-            # one contact per pair, in the model's pair order (the explicit pairs are
-            # the only collision source and every present pair is within the margin)
-            clear[self._slots] = np.minimum(d.contact.dist, DISTANCE_CLIP)
-        elif d.ncon:
-            geom, dist = d.contact.geom, d.contact.dist  # (ncon, 2), (ncon,)
-            slots = self._pair_slot[geom[:, 0], geom[:, 1]]
-            if d.ncon == self._n_pairs:
-                self._slots = slots
-                clear[slots] = np.minimum(dist, DISTANCE_CLIP)
-            else:  # a pair with two contacts (parallel capsules): keep the smaller
-                np.minimum.at(clear, slots, dist)
-        if self._n_self:
-            self._min_d = float(clear[: self._n_lk].min())
-            self._self_d = float(clear[self._n_lk :].min())
-        else:
-            self._min_d = float(clear.min())
+        """Pose the world; write the per-step part of the observation."""
+        world, obs, q = self.world, self._obs, self._q
+        world.pose(q)
         obs[self._s_sin] = np.sin(q)
         obs[self._s_cos] = np.cos(q)
         obs[self._s_qdot] = qdot
-        points = d.site_xpos[self._sites, : self.dim]
+        points = world.points
         obs[self._s_points] = points.ravel()
         obs[self._s_fruit_error] = self._fruit - points[-1]
-        obs[self._s_dist] = clear[: self._n_lk]
+        obs[self._s_dist] = world.clearances
         self._gripper = points[-1]
 
     def _distance_to_fruit(self) -> float:
         g = self._gripper - self._fruit
         return float(np.sqrt(g @ g))
 
-    def _info(self, arrived: bool, collided: bool, terms: dict[str, float]) -> dict[str, Any]:
-        close = self._min_d < self.safety_distance
-        info = {
+    def _reward_and_info(
+        self, arrived: bool, collided: bool, terms: dict[str, float]
+    ) -> tuple[float, dict[str, Any]]:
+        world = self.world
+        close = world.min_distance < self.params.safety_distance
+        measures: dict[str, Any] = {
             "distance_to_fruit": self._d_fruit,
-            "min_distance": self._min_d,
+            "min_distance": world.min_distance,
             "min_distance_so_far": self._min_so_far,
             "close_approach": bool(close),
             "collision": bool(collided),
-            "cost": 1.0 if close or collided else 0.0,
-            "is_success": bool(arrived),
         }
-        if self._n_self:
-            info["self_distance"] = self._self_d
-            info["self_collision"] = bool(self._self_d <= 0.0)
-        for key, value in terms.items():
-            info[f"reward_{key}"] = float(value)
-        return info
+        if self.params.self_collision:
+            measures["self_distance"] = world.self_distance
+            measures["self_collision"] = bool(world.self_distance <= 0.0)
+        return reward_and_info(
+            terms, cost=1.0 if close or collided else 0.0, is_success=arrived, **measures
+        )
+
+    def _info(self, arrived: bool, collided: bool, terms: dict[str, float]) -> dict[str, Any]:
+        return self._reward_and_info(arrived, collided, terms)[1]
 
     # ----------------------------------------------------------------- render
     def render(self) -> np.ndarray | None:
+        self._require_reset("render")
         if self.render_mode != "rgb_array":
             return None
         if self._renderer is None:
-            self._renderer = mujoco.Renderer(self.model, self.height, self.width)
-        camera = mujoco.MjvCamera()
-        if self.spec_arm.planar:
-            camera.lookat[:] = (0.35, -0.15, 0.0)
-            camera.distance, camera.azimuth, camera.elevation = 1.7, 90.0, -90.0
-        else:
-            camera.lookat[:] = (0.35, 0.0, 0.4)
-            camera.distance, camera.azimuth, camera.elevation = 1.7, 200.0, -20.0
-        self._renderer.update_scene(self.data, camera=camera)
-        scene = self._renderer.scene
-        for p0, p1 in zip(self._path[:-1], self._path[1:], strict=False):
-            if scene.ngeom >= scene.maxgeom:
-                break
-            geom = scene.geoms[scene.ngeom]
-            mujoco.mjv_initGeom(
-                geom,
-                mujoco.mjtGeom.mjGEOM_LINE,
-                np.zeros(3),
-                np.zeros(3),
-                np.eye(3).ravel(),
-                np.array([0.9, 0.5, 0.1, 1.0], dtype=np.float32),
+            self._renderer = mujoco.Renderer(
+                self.world.model, self.params.height, self.params.width
             )
-            mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_CAPSULE, 0.004, p0, p1)
-            scene.ngeom += 1
-        return self._renderer.render()
+        return self.world.render(self._renderer, self._path)
