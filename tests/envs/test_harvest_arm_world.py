@@ -301,3 +301,14 @@ def test_v1_terminates_on_self_collision_and_v0_ignores_it():
     v0.reset(seed=0, options=options)
     _, _, terminated, _, info = v0.step(np.zeros(5, dtype=np.float32))
     assert not info["collision"] and not terminated and "self_collision" not in info
+
+
+def test_docstring_table_is_the_default_arms_layout():
+    env = gym.make("motiongym/HarvestArm-v1").unwrapped
+    table = env.layout.table()
+    doc = "\n".join(line.strip() for line in type(env).__doc__.splitlines())
+    assert "\n".join(line.strip() for line in table.splitlines()) in doc
+    observation, _ = env.reset(seed=0)
+    assert set(env.layout.parse(observation)) >= {"q", "points", "distances"}
+    with pytest.raises(ValueError, match="shape"):
+        env.layout.parse(observation[:-1])  # the fields cover the whole vector
