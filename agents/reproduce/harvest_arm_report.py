@@ -56,11 +56,11 @@ def _ablation(console: Any, results: dict[str, Any]) -> None:
 
     table = Table(title="Ablations on the paired scenes (close: shortest distance < 0.03 m; "
                   "p: exact McNemar against full, close (axis) / collision / stalled)")  # fmt: skip
-    for column in ("arm", "variant", "n", "success %", "collision %", "self-coll. %",
-                   "close axis % [95% CI]", "close clear. %", "joint-to-path m",
+    for column in ("arm", "variant", "n", "succ. %", "coll. %", "self %",
+                   "close axis % [95% CI]", "close clear. %", "joint-path m",
                    "stalled %", "escaped %", "ms/step", "p close/coll/stall",
                    "d joint-path ± 95%"):  # fmt: skip
-        table.add_column(column)
+        table.add_column(column, no_wrap=True)
     for key, res in results.items():
         for name, r in res["rates"].items():
             test = res["ablation"].get(name)
@@ -84,7 +84,7 @@ def print_report(results: dict[str, Any], trend: dict[str, Any]) -> None:
     """The paper's tables with ours beside, the DOF trend and the ablation table."""
     from rich.console import Console
 
-    console = Console(width=200)
+    console = Console(width=240)
     _tables(console, results)
     for kind, t in trend.items():
         low, high = t["dofs"]

@@ -54,12 +54,16 @@ class HarvestArmWorld:
             self._pair_slot[gi, gj] = self._pair_slot[gj, gi] = self._n_lk + s
         self._n_self = len(self.index["self_pairs"])
         self._clear = np.full(self._n_lk + self._n_self, DISTANCE_CLIP)  # (L*K + S,)
-        self.clearances = self._clear[: self._n_lk]
         self.min_distance = self.self_distance = DISTANCE_CLIP
         self.points = np.zeros((self.n_points, self.dim))
         self.scene: Scene | None = None
         self._n_pairs = 0
         self._slots: np.ndarray | None = None
+
+    @property
+    def clearances(self) -> np.ndarray:
+        """Link-obstacle surface distances (L * K,), link-major, clipped at 1 m (a view)."""
+        return self._clear[: self._n_lk]
 
     def set_scene(self, scene: Scene, width: int) -> tuple[np.ndarray, np.ndarray]:
         """Move the obstacle slots (spheres first, then bars) and the fruit.
