@@ -166,6 +166,23 @@ def clearance_to_arm(points: np.ndarray, link_radius: float, scene: Scene) -> np
     return dist.min(axis=0) - link_radius - scene.radius
 
 
+def _sample_fruit(rng: np.random.Generator, kin: ArmKinematics, start: np.ndarray) -> np.ndarray:
+    """The first reachable fruit candidate in draw order, in batches (dim,)."""
+    planar = kin.spec.planar
+    fruit_box = PLANAR_FRUIT_BOX if planar else SPATIAL_FRUIT_BOX
+    home = np.array(kin.spec.home)
+    root = start[0] if planar else start[1]
+    for _ in range(20):
+        cand = rng.uniform(fruit_box[0], fruit_box[1], size=(_BATCH, kin.dim))
+        ok = (np.linalg.norm(cand - start[-1], axis=1) >= MIN_TRAVEL) & (
+            np.linalg.norm(cand - root, axis=1) <= MAX_REACH
+        )
+        for c in cand[ok]:
+            if solve_ik(kin, c, home)[1] < 2e-3:
+                return c
+    raise RuntimeError("no reachable fruit found in 20 batches")  # pragma: no cover
+
+
 def sample_scene(
     rng: np.random.Generator,
     kin: ArmKinematics,
@@ -176,25 +193,9 @@ def sample_scene(
     """Sample a scene as documented in the module docstring."""
     planar = kin.spec.planar
     box = PLANAR_BOX if planar else SPATIAL_BOX
-    fruit_box = PLANAR_FRUIT_BOX if planar else SPATIAL_FRUIT_BOX
     dim = kin.dim
-    home = np.array(kin.spec.home)
-    start = kin.forward(home)  # (P, dim)
-    root = start[0] if planar else start[1]
-    fruit = None
-    for _ in range(20):  # batches of candidates; the first reachable one in draw order
-        cand = rng.uniform(fruit_box[0], fruit_box[1], size=(_BATCH, dim))
-        ok = (np.linalg.norm(cand - start[-1], axis=1) >= MIN_TRAVEL) & (
-            np.linalg.norm(cand - root, axis=1) <= MAX_REACH
-        )
-        for c in cand[ok]:
-            if solve_ik(kin, c, home)[1] < 2e-3:
-                fruit = c
-                break
-        if fruit is not None:
-            break
-    else:  # pragma: no cover - the fruit box lies well inside the reach
-        raise RuntimeError("no reachable fruit found in 20 batches")
+    start = kin.forward(np.array(kin.spec.home))  # (P, dim)
+    fruit = _sample_fruit(rng, kin, start)
     low, high = np.maximum(box[0], fruit - CLUSTER), np.minimum(box[1], fruit + CLUSTER)
     parts = []
     for count, bars in ((n_obstacles - n_bars, False), (n_bars, True)):

@@ -491,3 +491,33 @@ def test_ablations_on_fixed_scenes():
     # the virtual plane: fewer gripper paths stalled in a local minimum
     no_plane = _ablation(*planar, seeds, virtual_plane=False)
     assert full_p[2].sum() < no_plane[2].sum(), (full_p[2].sum(), no_plane[2].sum())
+
+
+def test_the_vortex_escape_acts_exactly_where_a_planned_path_stalls():
+    """``potential-field-extended`` (our addition): escapes on the stalled scenes only."""
+    from motiongym.baselines.harvest_arm.policy import (
+        ExtendedPotentialFieldPolicy,
+        PotentialFieldPolicy,
+    )
+
+    env_id = "motiongym/HarvestArmPlanar-v1"
+    kwargs = dict(gym.spec(env_id).kwargs)
+    env = gym.make(env_id)
+    plans = {}
+    for cls in (PotentialFieldPolicy, ExtendedPotentialFieldPolicy):
+        policy = cls(env.observation_space, env.action_space, kwargs)
+        plans[cls] = []
+        for seed in range(60):
+            observation, _ = env.reset(seed=seed)
+            policy.predict(observation, episode_start=True)
+            d = policy.diagnostics()
+            fruit = env.unwrapped.scene.fruit
+            plans[cls].append((d["stalled"], d["escapes"], np.allclose(d["path"][-1], fruit)))
+    paper, ours = plans[PotentialFieldPolicy], plans[ExtendedPotentialFieldPolicy]
+    stalled = [s for s, _, _ in paper]
+    assert 0 < sum(stalled) < len(stalled)  # a minority of scenes
+    assert all(e == 0 for _, e, _ in paper)  # the paper's policy never escapes
+    assert [e > 0 for _, e, _ in ours] == stalled  # ours escapes exactly there
+    assert not any(arrived for s, _, arrived in paper if s)  # stalled paths stop short ...
+    escaped = [arrived for (s, _, _), (_, _, arrived) in zip(paper, ours, strict=True) if s]
+    assert any(escaped)  # ... ours reach the fruit on some of them
