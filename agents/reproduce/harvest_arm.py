@@ -6,35 +6,35 @@ random obstacles and spatial arms with 5, 6, 7 DOF among 10 random obstacles
 distance over the whole motion; per run: its mean, standard deviation and
 the percentage of trials below 0.03 m. As in the paper, the arm always drives
 on to the fruit (``terminate_on_collision=False``); success (gripper within
-tolerance of the fruit) and collision (clearance <= 0 at some step) are
-reported beside.
+tolerance of the fruit) and collision (an obstacle touched, or two
+non-adjacent links touching: the ``-v1`` IDs) are reported beside.
 
-Two distances per trial: the *clearance* (surface to surface, link capsules
-of radius 0.02 m vs obstacle spheres and bars, what the environment's
-``min_distance`` and ``cost`` use) and the *axis distance* (link centre
-segments to obstacle centres and bar axes, the paper's model of links and
-obstacles as lines and points). Run ``r`` uses the seeds ``1000 r + t``;
-every policy sees the same scenes: the paper's method (``potential-field``),
-the same with our two extensions of eq. 9-10 (``potential-field-extended``)
-and the plain resolved-rate baseline (``resolved-rate``).
+**Paired scenes.** The paper compares the DOF "on the same obstacle
+environments". Scenes are drawn by the first arm of each kind (planar 3-DOF,
+spatial 5-DOF) from seeds 0, 1, 2, ...; a scene is kept if it is valid for
+all three arms of its kind (obstacles 0.05 m clear of each arm's start pose,
+the fruit reachable by each: :mod:`motiongym.envs.harvest_arm.task`'s rules),
+and the first 200 kept are run ``r`` = 0-3 of 50. Every arm, policy and
+ablation sees exactly these scenes, passed as reset options.
 
-Where ours differ from the paper (full protocol, 200 trials per arm): the
-mean shortest axis distances agree (planar 0.075-0.083 m vs 0.067-0.080 m,
-spatial 0.082-0.095 m vs 0.078-0.100 m) and the spatial close approaches
-fall with DOF (about 10, 9, 6.5 % vs the paper's 6.5, 7.5, 1.5 %), but the
-planar ones stay near 13 % for 3, 4 and 5 DOF (paper 14, 7.5, 2.5 %). In our
-planar scenes almost every close approach happens on arrival, on the two
-links next to the gripper, against an obstacle about 0.2 m from the fruit
-that the gripper's path went round on the side away from the base: in the
-plane the arm's body cannot follow it round, whatever the DOF. The paper's
-scene distribution is not given; ours is documented in
-:mod:`motiongym.envs.harvest_arm.task`. The clearance (surface) figures are
-higher than the axis ones because links and obstacles have thickness.
+**One distance.** The paper's "shortest distance between the joints and the
+obstacles" treats the links as lines and the obstacles as points and lines
+(its eq. 9-10 measure ``rho`` from the link's line to the obstacle's point or
+axis). Our *axis distance* is that: link centre segments to obstacle centres
+and bar axes. It is the distance of every comparison with the paper below,
+for our method and the baselines alike; the *clearance* (surface to surface:
+link capsules of radius 0.02 m against spheres of 0.01-0.02 m and bars of
+0.008 m; the environment's ``min_distance`` and ``cost``) is printed beside
+it and is 0.028-0.04 m smaller.
 
-Printed: one table per paper table, the paper's run beside ours; written:
-``harvest_arm.json`` (every number), ``harvest_arm_close_approaches.png``
-(% below 0.03 m per arm: paper, ours, baseline) and ``harvest_arm_fig8.png``
-(paper Fig. 8: a spatial run among bars, the safe path, the arm).
+Printed: the paper's Tables 4-9 (paper run beside ours: axis distance, then
+clearance); the DOF trend (exact McNemar test on the paired scenes: the
+lowest against the highest DOF of each kind); the ablation table (the
+paper's method in full, without eq. 8, without eq. 9-10, without the virtual
+plane, with our vortex escape, and the resolved-rate baseline) with the
+measure each mechanism is for and McNemar's p against the full method.
+Written: ``harvest_arm.json`` (every number), ``harvest_arm_close_approaches.png``
+and ``harvest_arm_fig8.png`` (paper Fig. 8: a spatial run among bars).
 """
 
 from __future__ import annotations
@@ -46,101 +46,151 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from scipy.stats import binomtest
 
 import motiongym  # noqa: F401  (registers the IDs)
-from motiongym.baselines import make_policy
+from motiongym.agents.evaluate import Step, run_episode
+from motiongym.baselines.harvest_arm.policy import (
+    ExtendedPotentialFieldPolicy,
+    PotentialFieldPolicy,
+    ResolvedRatePolicy,
+)
+from motiongym.envs.geometry import closest_point_on_segment
+from motiongym.envs.harvest_arm.task import START_CLEARANCE, clearance_to_arm, solve_ik
 
 PAPER = {  # (mean m, std m, % below 0.03 m) per run, Tables 4-9
-    ("planar", 3): [
-        (0.0732, 0.0350, 8),
-        (0.0700, 0.0394, 22),
-        (0.0786, 0.0352, 12),
-        (0.0796, 0.0407, 14),
-    ],
-    ("planar", 4): [
-        (0.0668, 0.0273, 8),
-        (0.0691, 0.0347, 12),
-        (0.0772, 0.0452, 6),
-        (0.0737, 0.0288, 4),
-    ],
-    ("planar", 5): [
-        (0.0681, 0.0220, 4),
-        (0.0748, 0.0237, 0),
-        (0.0745, 0.0228, 2),
-        (0.0685, 0.0245, 4),
-    ],
-    ("spatial", 5): [
-        (0.0834, 0.0414, 8),
-        (0.0890, 0.0402, 6),
-        (0.0991, 0.0497, 6),
-        (0.0926, 0.0461, 6),
-    ],
-    ("spatial", 6): [
-        (0.0838, 0.0358, 8),
-        (0.0775, 0.0382, 8),
-        (0.0861, 0.0383, 6),
-        (0.0917, 0.0424, 8),
-    ],
-    ("spatial", 7): [
-        (0.0939, 0.0380, 0),
-        (0.0964, 0.0395, 2),
-        (0.0976, 0.0422, 0),
-        (0.1003, 0.0406, 4),
-    ],
+    ("planar", 3): [(0.0732, 0.0350, 8), (0.0700, 0.0394, 22), (0.0786, 0.0352, 12),
+                    (0.0796, 0.0407, 14)],
+    ("planar", 4): [(0.0668, 0.0273, 8), (0.0691, 0.0347, 12), (0.0772, 0.0452, 6),
+                    (0.0737, 0.0288, 4)],
+    ("planar", 5): [(0.0681, 0.0220, 4), (0.0748, 0.0237, 0), (0.0745, 0.0228, 2),
+                    (0.0685, 0.0245, 4)],
+    ("spatial", 5): [(0.0834, 0.0414, 8), (0.0890, 0.0402, 6), (0.0991, 0.0497, 6),
+                     (0.0926, 0.0461, 6)],
+    ("spatial", 6): [(0.0838, 0.0358, 8), (0.0775, 0.0382, 8), (0.0861, 0.0383, 6),
+                     (0.0917, 0.0424, 8)],
+    ("spatial", 7): [(0.0939, 0.0380, 0), (0.0964, 0.0395, 2), (0.0976, 0.0422, 0),
+                     (0.1003, 0.0406, 4)],
+}  # fmt: skip
+TABLE = {("planar", 3): 4, ("planar", 4): 5, ("planar", 5): 6,
+         ("spatial", 5): 7, ("spatial", 6): 8, ("spatial", 7): 9}  # fmt: skip
+DOFS = {"planar": (3, 4, 5), "spatial": (5, 6, 7)}
+SAFETY = 0.03  # m, the paper's collision-risk distance
+VARIANTS: dict[str, tuple[type, dict[str, bool]]] = {
+    "full": (PotentialFieldPolicy, {}),
+    "no eq. 8": (PotentialFieldPolicy, {"trajectory_following": False}),
+    "no eq. 9-10": (PotentialFieldPolicy, {"link_avoidance": False}),
+    "no virtual plane": (PotentialFieldPolicy, {"virtual_plane": False}),
+    "with escape": (ExtendedPotentialFieldPolicy, {}),
+    "resolved-rate": (ResolvedRatePolicy, {}),
 }
-TABLE = {
-    ("planar", 3): 4,
-    ("planar", 4): 5,
-    ("planar", 5): 6,
-    ("spatial", 5): 7,
-    ("spatial", 6): 8,
-    ("spatial", 7): 9,
-}
-POLICIES = ("potential-field", "potential-field-extended", "resolved-rate")
-SAFETY = 0.03  # m
+"""The paper's method (``potential-field``), each mechanism off, our escape
+(``potential-field-extended``) and the plain baseline."""
 
 
 def _env_id(kind: str) -> str:
-    return "motiongym/HarvestArmPlanar-v0" if kind == "planar" else "motiongym/HarvestArm-v0"
+    return "motiongym/HarvestArmPlanar-v1" if kind == "planar" else "motiongym/HarvestArm-v1"
 
 
-def run_trial(env: gym.Env, policy: Any, seed: int, record: bool = False) -> dict[str, Any]:
-    """One trial: shortest clearance and axis distance, success, collision (and the poses)."""
-    base = env.unwrapped
-    layout, link_radius = base.layout, base.link_radius
-    observation, info = env.reset(seed=seed)
-    policy.reset()
-    clearance, axis = np.inf, np.inf
-    poses, start, steps = [], True, 0
-    while True:
-        o = layout.parse(observation)
-        axes = o["distances"] + link_radius + o["radius"][None, :]
-        axis = min(axis, float(axes[:, o["mask"]].min()))
-        clearance = min(clearance, info["min_distance"])
-        if record:
-            poses.append(o["points"].copy())
-        action, _ = policy.predict(observation, episode_start=start)
-        start = False
-        observation, _, terminated, truncated, info = env.step(action)
-        steps += 1
-        if terminated or truncated:
-            break
-    o = layout.parse(observation)
-    axes = o["distances"] + link_radius + o["radius"][None, :]
-    axis = min(axis, float(axes[:, o["mask"]].min()))
-    clearance = min(clearance, info["min_distance"])
-    if record:
-        poses.append(o["points"].copy())
-    out = {
-        "clearance": clearance,
-        "axis": axis,
-        "success": bool(info["is_success"]),
-        "collision": clearance <= 0.0,
-        "steps": steps,
-    }
-    if record:
-        out["poses"] = np.array(poses)
+def _kwargs(kind: str, dof: int) -> dict[str, Any]:
+    return {**gym.spec(_env_id(kind)).kwargs, "dof": dof, "terminate_on_collision": False}
+
+
+def _as_options(scene: Any) -> dict[str, Any]:
+    obstacles = [
+        {"a": a.tolist(), "b": b.tolist(), "radius": float(r)}
+        if bar
+        else {"center": a.tolist(), "radius": float(r)}
+        for a, b, r, bar in zip(scene.a, scene.b, scene.radius, scene.is_bar, strict=True)
+    ]
+    return {"fruit": scene.fruit.tolist(), "obstacles": obstacles}
+
+
+def paired_scenes(kind: str, n: int) -> tuple[list[dict[str, Any]], int]:
+    """The first ``n`` scenes valid for every arm of ``kind`` (reset options), and seeds drawn."""
+    envs = [gym.make(_env_id(kind), **_kwargs(kind, dof)).unwrapped for dof in DOFS[kind]]
+    scenes, seed = [], 0
+    while len(scenes) < n:
+        envs[0].reset(seed=seed)
+        scene = envs[0].scene
+        seed += 1
+        valid = True
+        for env in envs[1:]:
+            kin, home = env.kinematics, np.array(env.spec_arm.home)
+            start = kin.forward(home)
+            valid &= bool(clearance_to_arm(start, env.link_radius, scene).min() >= START_CLEARANCE)
+            valid = valid and solve_ik(kin, scene.fruit, home)[1] < 2e-3
+        if valid:
+            scenes.append(_as_options(scene))
+    return scenes, seed
+
+
+class _Trial:
+    """A run_episode hook: shortest distances, collisions and the poses of one trial."""
+
+    def __init__(self, env: gym.Env, record: bool = False) -> None:
+        base = env.unwrapped
+        self.layout, self.link_radius, self.record = base.layout, base.link_radius, record
+        self.axis = self.clearance = np.inf
+        self.collision = self.self_collision = False
+        self.poses: list[np.ndarray] = []
+
+    def __call__(self, step: Step) -> None:
+        o = self.layout.parse(step.next_observation)
+        axes = o["distances"] + self.link_radius + o["radius"][None, :]  # (L, K) centre lines
+        self.axis = min(self.axis, float(axes[:, o["mask"]].min()))
+        self.clearance = min(self.clearance, step.info["min_distance"])
+        self.collision |= bool(step.info["collision"])
+        self.self_collision |= bool(step.info.get("self_collision", False))
+        self.poses.append(o["points"].copy())
+
+    def joint_to_path(self) -> float:
+        """Mean distance of the joints (base and gripper excluded) to the gripper's travelled
+        path, over the second half of the motion (m): eq. 8's measure."""
+        poses = np.array(self.poses)  # (T, P, dim)
+        trail = poses[:, -1]
+        values = []
+        for t in range(max(2, len(poses) // 2), len(poses)):
+            d, _ = closest_point_on_segment(
+                poses[t, 1:-1, None], trail[None, :t], trail[None, 1 : t + 1]
+            )
+            values.append(d.min(axis=1).mean())
+        return float(np.mean(values)) if values else float("nan")
+
+
+def run_variant(kind: str, dof: int, variant: str, scenes: list[dict]) -> dict[str, Any]:
+    """One arm and one policy variant on the paired scenes: per-trial measures."""
+    env = gym.make(_env_id(kind), **_kwargs(kind, dof))
+    cls, options = VARIANTS[variant]
+    policy = cls(env.observation_space, env.action_space, _kwargs(kind, dof), **options)
+    trials: dict[str, list] = {k: [] for k in (
+        "axis", "clearance", "success", "collision", "self_collision", "joint_to_path",
+        "stalled", "escaped", "steps")}  # fmt: skip
+    t0 = time.perf_counter()
+    for i, scene in enumerate(scenes):
+        hook = _Trial(env)
+        result = run_episode(env, policy, seed=i, hook=hook, options=scene)
+        diagnostics = policy.diagnostics()
+        for key, value in (
+            ("axis", hook.axis), ("clearance", hook.clearance),
+            ("success", bool(result["is_success"])), ("collision", hook.collision),
+            ("self_collision", hook.self_collision), ("joint_to_path", hook.joint_to_path()),
+            ("stalled", bool(diagnostics.get("stalled", False))),
+            ("escaped", diagnostics.get("escapes", 0) > 0), ("steps", result["length"]),
+        ):  # fmt: skip
+            trials[key].append(value)
+    seconds = time.perf_counter() - t0
+    out = {key: np.array(value) for key, value in trials.items()}
+    out["ms_per_step"] = 1e3 * seconds / max(int(out["steps"].sum()), 1)
     return out
+
+
+def mcnemar(first: np.ndarray, second: np.ndarray) -> dict[str, float]:
+    """Exact McNemar test of paired booleans: discordant counts and two-sided p."""
+    b = int(np.sum(first & ~second))
+    c = int(np.sum(~first & second))
+    p = 1.0 if b + c == 0 else float(binomtest(b, b + c, 0.5).pvalue)
+    return {"only_first": b, "only_second": c, "p": p}
 
 
 def _summary(values: np.ndarray) -> dict[str, float]:
@@ -151,168 +201,119 @@ def _summary(values: np.ndarray) -> dict[str, float]:
     }
 
 
-def evaluate(kind: str, dof: int, runs: int, trials: int) -> dict[str, Any]:
-    """The protocol for one arm; both policies on the same seeds."""
-    env_id = _env_id(kind)
-    env = gym.make(env_id, dof=dof, terminate_on_collision=False)
-    kwargs = {**gym.spec(env_id).kwargs, "dof": dof, "terminate_on_collision": False}
-    result: dict[str, Any] = {"paper": PAPER[(kind, dof)], "table": TABLE[(kind, dof)]}
-    for name in POLICIES:
-        policy = make_policy(env_id, name, env.observation_space, env.action_space, kwargs)
-        per_run = []
-        t0, n_steps = time.perf_counter(), 0
-        for r in range(runs):
-            trials_out = [run_trial(env, policy, 1000 * r + t) for t in range(trials)]
-            n_steps += sum(t["steps"] for t in trials_out)
-            clear = np.array([t["clearance"] for t in trials_out])
-            axis = np.array([t["axis"] for t in trials_out])
-            per_run.append(
-                {
-                    "clearance": _summary(clear),
-                    "axis": _summary(axis),
-                    "success_pct": float(100 * np.mean([t["success"] for t in trials_out])),
-                    "collision_pct": float(100 * np.mean([t["collision"] for t in trials_out])),
-                }
-            )
-        result[name] = {
-            "runs": per_run,
-            "ms_per_step": 1e3 * (time.perf_counter() - t0) / max(n_steps, 1),
+def _rates(t: dict[str, Any]) -> dict[str, float]:
+    n = len(t["axis"])
+    close = t["axis"] < SAFETY
+    return {
+        "n": n,
+        "success_pct": 100.0 * t["success"].mean(),
+        "collision_pct": 100.0 * t["collision"].mean(),
+        "self_collision_pct": 100.0 * t["self_collision"].mean(),
+        "close_axis_pct": 100.0 * close.mean(),
+        "close_axis_ci95": _wilson(int(close.sum()), n),
+        "close_clearance_pct": 100.0 * (t["clearance"] < SAFETY).mean(),
+        "mean_axis": float(t["axis"].mean()),
+        "mean_clearance": float(t["clearance"].mean()),
+        "joint_to_path": float(np.nanmean(t["joint_to_path"])),
+        "stalled_pct": 100.0 * t["stalled"].mean(),
+        "escaped_pct": 100.0 * t["escaped"].mean(),
+        "ms_per_step": float(t["ms_per_step"]),
+    }
+
+
+def _wilson(k: int, n: int, z: float = 1.96) -> list[float]:
+    """Wilson 95 % interval of a proportion, in %."""
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return [100.0 * (centre - half), 100.0 * (centre + half)]
+
+
+def _ablation_tests(trials: dict[str, dict], full: dict) -> dict[str, dict]:
+    """Each variant against the full method on the paired scenes."""
+    out = {}
+    for name, t in trials.items():
+        if name == "full":
+            continue
+        diff = t["joint_to_path"] - full["joint_to_path"]
+        diff = diff[np.isfinite(diff)]
+        half = 1.96 * diff.std(ddof=1) / np.sqrt(len(diff)) if len(diff) > 1 else float("nan")
+        out[name] = {
+            "close_axis": mcnemar(t["axis"] < SAFETY, full["axis"] < SAFETY),
+            "collision": mcnemar(t["collision"], full["collision"]),
+            "stalled": mcnemar(t["stalled"], full["stalled"]),
+            "joint_to_path_diff": [float(diff.mean()), float(half)],
         }
-    return result
+    return out
 
 
-def _cell(summary: dict[str, float]) -> str:
-    return f"{summary['mean']:.4f} ± {summary['std']:.4f} ({summary['below_pct']:.0f}%)"
+def evaluate(kind: str, dof: int, scenes: list[dict], runs: int) -> dict[str, Any]:
+    """Every variant on one arm: per-run tables, rates and the ablation tests."""
+    trials = {name: run_variant(kind, dof, name, scenes) for name in VARIANTS}
+    per = len(scenes) // runs
+    tables = {
+        name: [
+            {
+                "axis": _summary(trials[name]["axis"][r * per : (r + 1) * per]),
+                "clearance": _summary(trials[name]["clearance"][r * per : (r + 1) * per]),
+            }
+            for r in range(runs)
+        ]
+        for name in ("full", "with escape", "resolved-rate")
+    }
+    return {
+        "paper": PAPER[(kind, dof)],
+        "table": TABLE[(kind, dof)],
+        "runs": tables,
+        "rates": {name: _rates(t) for name, t in trials.items()},
+        "ablation": _ablation_tests(trials, trials["full"]),
+        "_trials": trials,
+    }
 
 
-def _print(results: dict[str, Any]) -> None:
-    from rich.console import Console
-    from rich.table import Table
-
-    console = Console(width=160)
-    for key, res in results.items():
-        kind, dof = key.split("-")
-        table = Table(
-            title=f"Table {res['table']}: shortest distances to obstacles, {kind} {dof}-DOF arm "
-            "(m, mean ± std (% of trials below 0.03 m))"
-        )
-        table.add_column("run")
-        table.add_column("paper")
-        table.add_column("ours: axis distance")
-        table.add_column("ours: clearance")
-        table.add_column("succ/coll %")
-        table.add_column("extended: clearance")
-        table.add_column("resolved-rate: clearance")
-        table.add_column("RR succ/coll %")
-        pf, ext, rr = (res[name]["runs"] for name in POLICIES)
-        for i, (p, a, e, b) in enumerate(zip(res["paper"], pf, ext, rr, strict=False)):
-            table.add_row(
-                str(i + 1),
-                f"{p[0]:.4f} ± {p[1]:.4f} ({p[2]}%)",
-                _cell(a["axis"]),
-                _cell(a["clearance"]),
-                f"{a['success_pct']:.0f}/{a['collision_pct']:.0f}",
-                _cell(e["clearance"]),
-                _cell(b["clearance"]),
-                f"{b['success_pct']:.0f}/{b['collision_pct']:.0f}",
-            )
-        console.print(table)
-
-
-def _pooled(res: dict[str, Any], policy: str, measure: str) -> float:
-    return float(np.mean([r[measure]["below_pct"] for r in res[policy]["runs"]]))
-
-
-def _figures(results: dict[str, Any], out_dir: pathlib.Path, quick: bool) -> list[str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    files = []
-    keys = list(results)
-    x = np.arange(len(keys))
-    paper = [np.mean([r[2] for r in results[k]["paper"]]) for k in keys]
-    fig, ax = plt.subplots(figsize=(8, 4))
-    ax.bar(x - 0.3, paper, 0.2, label="paper")
-    ax.bar(x - 0.1, [_pooled(results[k], "potential-field", "axis") for k in keys], 0.2,
-           label="ours, axis distance")  # fmt: skip
-    ax.bar(x + 0.1, [_pooled(results[k], "potential-field", "clearance") for k in keys], 0.2,
-           label="ours, clearance")  # fmt: skip
-    ax.bar(x + 0.3, [_pooled(results[k], "resolved-rate", "clearance") for k in keys], 0.2,
-           label="plain resolved-rate, clearance")  # fmt: skip
-    ax.plot(x + 0.1, [_pooled(results[k], "potential-field-extended", "clearance") for k in keys],
-            "k_", ms=14, label="extended, clearance")  # fmt: skip
-    ax.set_xticks(x, keys)
-    ax.set_ylabel("% of trials below 0.03 m")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = out_dir / "harvest_arm_close_approaches.png"
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    files.append(path.name)
-    files.append(_figure8(out_dir, plt))
-    return files
-
-
-def _figure8(out_dir: pathlib.Path, plt: Any) -> str:
-    """Paper Fig. 8: a 3-D run among bars, the safe path, the arm."""
-    env_id = _env_id("spatial")
-    env = gym.make(env_id, dof=5, terminate_on_collision=False)
-    kwargs = {**gym.spec(env_id).kwargs, "dof": 5}
-    policy = make_policy(env_id, "potential-field", env.observation_space, env.action_space, kwargs)
-    trial = run_trial(env, policy, seed=7, record=True)
-    scene = env.unwrapped.scene
-    path = policy._memories[0]["path"]
-    fig = plt.figure(figsize=(6, 6))
-    ax = fig.add_subplot(projection="3d")
-    for a, b, bar in zip(scene.a, scene.b, scene.is_bar, strict=True):
-        if bar:
-            ax.plot(*np.stack([a, b]).T, color="saddlebrown", lw=2)
-        else:
-            ax.scatter(*a, color="green", s=30)
-    ax.scatter(*scene.fruit, s=120, facecolors="none", edgecolors="red")
-    ax.plot(*path.T, color="orange", lw=1, label="safe path (eq. 2-7)")
-    poses = trial["poses"]
-    for i in np.linspace(0, len(poses) - 1, 6).astype(int):
-        ax.plot(*poses[i].T, color="navy", lw=2.5, alpha=0.3 + 0.7 * i / (len(poses) - 1))
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_zlabel("z (m)")
-    ax.set_title(f"5-DOF arm among bars; shortest clearance {trial['clearance']:.3f} m")
-    ax.legend(fontsize=8)
-    name = "harvest_arm_fig8.png"
-    fig.savefig(out_dir / name, dpi=100)
-    plt.close(fig)
-    return name
+def _dof_trend(results: dict[str, Any]) -> dict[str, Any]:
+    """McNemar, lowest against highest DOF of each kind, full method, paired scenes."""
+    out = {}
+    for kind, dofs in DOFS.items():
+        low = results[f"{kind}-{dofs[0]}"]["_trials"]["full"]
+        high = results[f"{kind}-{dofs[-1]}"]["_trials"]["full"]
+        out[kind] = {
+            "dofs": [dofs[0], dofs[-1]],
+            "close_axis": mcnemar(low["axis"] < SAFETY, high["axis"] < SAFETY),
+            "close_clearance": mcnemar(low["clearance"] < SAFETY, high["clearance"] < SAFETY),
+            "collision": mcnemar(low["collision"], high["collision"]),
+        }
+    return out
 
 
 def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
-    """Tables 4-9 on our scenes (``quick``: 1 run x 6 trials per arm)."""
+    """Tables 4-9, the DOF trend and the ablations (``quick``: 1 run x 6 paired scenes)."""
+    from motiongym.agents.reproduce.harvest_arm_report import figures, print_report
+
     out_dir = pathlib.Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     runs, trials = (1, 6) if quick else (4, 50)
-    results = {}
-    for kind, dofs in (("planar", (3, 4, 5)), ("spatial", (5, 6, 7))):
+    t0 = time.perf_counter()
+    results, drawn = {}, {}
+    for kind, dofs in DOFS.items():
+        scenes, drawn[kind] = paired_scenes(kind, runs * trials)
         for dof in dofs:
-            results[f"{kind}-{dof}"] = evaluate(kind, dof, runs, trials)
-    _print(results)
-    summary = {
-        key: {
-            "paper_below_pct": float(np.mean([r[2] for r in res["paper"]])),
-            "ours_axis_below_pct": _pooled(res, "potential-field", "axis"),
-            "ours_clearance_below_pct": _pooled(res, "potential-field", "clearance"),
-            "extended_clearance_below_pct": _pooled(res, "potential-field-extended", "clearance"),
-            "baseline_clearance_below_pct": _pooled(res, "resolved-rate", "clearance"),
-            "baseline_axis_below_pct": _pooled(res, "resolved-rate", "axis"),
-        }
-        for key, res in results.items()
-    }
+            results[f"{kind}-{dof}"] = evaluate(kind, dof, scenes, runs)
+    trend = _dof_trend(results)
+    print_report(results, trend)
     numbers = {
-        "protocol": {"runs": runs, "trials": trials, "safety_distance": SAFETY},
-        "results": results,
-        "summary": summary,
+        "protocol": {
+            "runs": runs,
+            "trials": trials,
+            "safety_distance": SAFETY,
+            "distance": "axis (link centre segments to obstacle centres and bar axes)",
+            "seeds_drawn": drawn,
+        },
+        "results": {k: {f: v for f, v in r.items() if f != "_trials"} for k, r in results.items()},
+        "dof_trend": trend,
     }
-    numbers["figures"] = _figures(results, out_dir, quick)
-    (out_dir / "harvest_arm.json").write_text(json.dumps(numbers, indent=2))
+    numbers["figures"] = figures(results, out_dir)
+    numbers["seconds"] = time.perf_counter() - t0
+    (out_dir / "harvest_arm.json").write_text(json.dumps(numbers, indent=2, default=float))
+    print(f"harvest-arm reproduction: {numbers['seconds']:.0f} s")
     return numbers

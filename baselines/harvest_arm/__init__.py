@@ -18,4 +18,6 @@ _POLICIES = {
 POLICIES: dict[str, dict[str, str]] = {
     "motiongym/HarvestArm-v0": dict(_POLICIES),
     "motiongym/HarvestArmPlanar-v0": dict(_POLICIES),
+    "motiongym/HarvestArm-v1": dict(_POLICIES),
+    "motiongym/HarvestArmPlanar-v1": dict(_POLICIES),
 }

@@ -3,17 +3,21 @@
 ``potential-field`` (:class:`PotentialFieldPolicy`), the paper's method:
 
 1. at the episode's first step, plan the gripper's safe path from its start
-   to the fruit with the potential field (eq. 2-7, RK4,
-   :mod:`.potential_field`; after a stall in a local minimum, our escape
-   stands in for the paper's undescribed "virtual plane");
+   to the fruit with the potential field (eq. 2-7, RK4, the obstacle terms
+   in the virtual plane normal to the way to the fruit,
+   :mod:`.potential_field`);
 2. every step, the gripper's velocity ``X_dot`` follows that path (aim at the
    path point one control period ahead of the nearest one, at most
    ``|V_end_ref|``; past the path's end, straight at the fruit); the joint
-   points' reference velocities combine trajectory following with the
-   avoidance of point and bar obstacles (eq. 8-11, :mod:`.reference_velocity`);
+   points follow the leader (eq. 8) and every link point near an obstacle
+   is pushed off it (eq. 9-11, :mod:`.reference_velocity`);
 3. the joint rates are eq. 1's weighted pseudo-inverse with the null-space
-   term, within joint ranges and speed limits (:mod:`.redundancy`), all
-   weights ``k_i = 1``.
+   term, within joint ranges and speed limits (:mod:`.redundancy`), weights
+   ``k_i = 1`` for the joint points and ``1 + |w_ob|`` for the link points.
+
+``potential-field-extended`` (:class:`ExtendedPotentialFieldPolicy`): the
+same plus our "vortex" escape from a local minimum of the path (not the
+paper's; :func:`.potential_field.plan_path`).
 
 ``resolved-rate`` (:class:`ResolvedRatePolicy`): the gripper straight at the
 fruit at ``|V_end_ref|``, joint rates by the ordinary pseudo-inverse of the
@@ -33,16 +37,21 @@ import numpy as np
 from motiongym.baselines.harvest_arm.potential_field import plan_path
 from motiongym.baselines.harvest_arm.redundancy import limited_rates
 from motiongym.baselines.harvest_arm.reference_velocity import (
-    bar_obstacle_terms,
     combine,
-    point_obstacle_terms,
-    trajectory_following,
+    follow_the_leader,
+    link_avoidance,
 )
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec
+from motiongym.envs.core import check_bool, params_from_kwargs
+from motiongym.envs.harvest_arm.model import ArmKinematics
 from motiongym.envs.harvest_arm.observation import ObservationLayout
+from motiongym.envs.harvest_arm.params import HarvestArmParams
 
 GRIPPER_SPEED = 0.2  # m/s, |V_end_ref| (the paper does not give it) and every |V_i_ref|
+JOINT_DAMPING = 1e-3  # eq. 1's S1 + JOINT_DAMPING trace(S1)/n I: a small cost on joint rates
+"""Without it the null space drifts along near-free joint combinations (the 7-DOF
+arm's waist and upper-arm roll) to their limits where the references cannot all
+be met; the fruit then ends out of reach (docs/experiments/HarvestArm-v1.md)."""
 
 
 class _ArmPolicy(ScriptedPolicy):
@@ -55,13 +64,11 @@ class _ArmPolicy(ScriptedPolicy):
         env_kwargs: dict[str, Any] | None = None,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
-        kw = self.env_kwargs
-        planar = bool(kw.get("planar", False))
-        self.arm = arm_spec(int(kw.get("dof") or (5 if planar else 7)), planar)
-        self.link_radius = float(kw.get("link_radius", 0.02))
-        self.dt = float(kw.get("dt", 0.05))
+        params = params_from_kwargs(HarvestArmParams, self.env_kwargs, ignore=("render_mode",))
+        self.arm = params.arm
+        self.link_radius, self.dt = params.link_radius, params.dt
         self.kin = ArmKinematics(self.arm, self.link_radius, self.dt)
-        n_slots = int(kw.get("n_obstacles") or (8 if planar else 10))
+        n_slots = params.n_obstacles
         self.layout = ObservationLayout(self.arm.dof, self.arm.dim, self.kin.n_points, n_slots)
         if observation_space.shape != (self.layout.size,):
             raise ValueError(
@@ -77,15 +84,50 @@ class _ArmPolicy(ScriptedPolicy):
 
 
 class PotentialFieldPolicy(_ArmPolicy):
-    """The paper's method: potential-field path, reference velocities, eq. 1."""
+    """The paper's method: potential-field path, reference velocities, eq. 1.
 
-    interior_only = True  # the paper's applicability tests of eq. 9-10
-    both_ends = False  # the paper's X_i: a link's terms go to its proximal point
+    Keyword options switch each mechanism off for ablations (all on by
+    default, except our escape): ``trajectory_following`` (eq. 8),
+    ``link_avoidance`` (eq. 9-10), ``virtual_plane`` (the obstacle selection
+    of the gripper's field), ``escape`` (our "vortex" escape from local
+    minima, not the paper's; on in ``potential-field-extended``).
+
+    :meth:`diagnostics` keys: ``path`` (N, dim) the planned gripper path,
+    ``stalled`` (the path stopped in a local minimum), ``escapes`` (vortex
+    escapes used), ``control_points`` (link points under eq. 9-10 this step).
+    """
+
+    default_escape = False
+
+    def __init__(
+        self,
+        observation_space: gym.Space,
+        action_space: gym.Space,
+        env_kwargs: dict[str, Any] | None = None,
+        *,
+        trajectory_following: bool = True,
+        link_avoidance: bool = True,
+        virtual_plane: bool = True,
+        escape: bool | None = None,
+    ) -> None:
+        super().__init__(observation_space, action_space, env_kwargs)
+        self.trajectory_following = check_bool("trajectory_following", trajectory_following)
+        self.link_avoidance = check_bool("link_avoidance", link_avoidance)
+        self.virtual_plane = check_bool("virtual_plane", virtual_plane)
+        self.escape = self.default_escape if escape is None else check_bool("escape", escape)
 
     def new_memory(self) -> dict[str, Any]:
-        return {"path": None, "index": 0}
+        return {"path": None, "index": 0, "plan": {}, "control_points": 0}
 
-    def plan(self, o: dict[str, np.ndarray], start: np.ndarray) -> np.ndarray:
+    def describe(self, memory: dict[str, Any]) -> dict[str, Any]:
+        return {
+            "path": memory["path"],
+            "stalled": bool(memory["plan"].get("stalled", False)),
+            "escapes": int(memory["plan"].get("escapes", 0)),
+            "control_points": memory["control_points"],
+        }
+
+    def plan(self, o: dict[str, np.ndarray], start: np.ndarray, report: dict) -> np.ndarray:
         """The safe gripper path (N, dim) for the parsed observation ``o``."""
         mask = o["mask"]
         return plan_path(
@@ -97,6 +139,9 @@ class PotentialFieldPolicy(_ArmPolicy):
             speed=GRIPPER_SPEED,
             step=self.dt,
             gripper_radius=self.link_radius,
+            escape=self.escape,
+            virtual_plane=self.virtual_plane,
+            report=report,
         )
 
     def gripper_velocity(self, x: np.ndarray, memory: dict[str, Any]) -> np.ndarray:
@@ -116,54 +161,75 @@ class PotentialFieldPolicy(_ArmPolicy):
     def act(self, observation: np.ndarray, memory: dict[str, Any]) -> np.ndarray:
         o = self.layout.parse(observation)
         points, jacs = self.kin.jacobians(o["q"])  # (P, dim), (P, dim, n)
-        x = points[-1]
         if memory["path"] is None:
-            memory["path"] = self.plan(o, x)
+            memory["path"] = self.plan(o, points[-1], memory["plan"])
             memory["fruit"] = o["fruit"]
-        x_dot = self.gripper_velocity(x, memory)
-        speed = float(np.linalg.norm(x_dot))
-        v = x_dot / speed if speed > 1e-9 else np.zeros_like(x_dot)
-        refs = self.reference_velocities(o, points, v)
-        refs[-1] = x_dot  # the gripper's own reference is its path velocity
+        x_dot = self.gripper_velocity(points[-1], memory)
+        jn = jacs[-1]  # (dim, n) the gripper's
+        jacs, refs, weights = self.reference_velocities(o, points, jacs, x_dot, memory)
         rates = limited_rates(
-            jacs[-1],
+            jn,
             x_dot,
             jacs,
             refs,
-            np.ones(len(points)),
+            weights,
             o["q"],
             self.limits,
             self.speeds,
             self.dt,
+            JOINT_DAMPING,
         )
         return self._to_action(rates)
 
     def reference_velocities(
-        self, o: dict[str, np.ndarray], points: np.ndarray, v: np.ndarray
-    ) -> np.ndarray:
-        """Eq. 8-11: ``X_i_dot`` of every joint point (P, dim)."""
+        self,
+        o: dict[str, np.ndarray],
+        points: np.ndarray,
+        jacs: np.ndarray,
+        x_dot: np.ndarray,
+        memory: dict[str, Any],
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Eq. 8-11: the weighted points' Jacobians (M, dim, n), references (M, dim), ``k_i`` (M,).
+
+        The joint points (gripper last) follow the leader (eq. 8), weight 1;
+        then one control point per link near an obstacle (eq. 9-10, eq. 11),
+        weight ``1 + |w_ob|`` (the paper's ``k_i`` are not given; ours make a
+        point's avoidance outweigh path following as its clearance closes,
+        as eq. 5's magnitude grows).
+        """
+        if self.trajectory_following:
+            refs = follow_the_leader(points, x_dot)
+        else:
+            refs = np.zeros_like(points)
+            refs[-1] = x_dot
+        memory["control_points"] = 0
+        weights = np.ones(len(points))
+        if not self.link_avoidance:
+            return jacs, refs, weights
         mask = o["mask"]
-        sphere = mask & ~o["is_bar"]
-        bar = mask & o["is_bar"]
-        w_d = trajectory_following(points, v)
-        r, ext = (
+        cp = link_avoidance(
+            points,
+            o["a"][mask],
+            o["b"][mask],
+            o["radius"][mask],
+            o["is_bar"][mask],
             self.link_radius,
-            {"interior_only": self.interior_only, "both_ends": self.both_ends},
         )
-        w_ob = point_obstacle_terms(points, o["a"][sphere], o["radius"][sphere], r, **ext)
-        w_ob += bar_obstacle_terms(points, o["a"][bar], o["b"][bar], o["radius"][bar], r, **ext)
-        return combine(w_d, w_ob, GRIPPER_SPEED)
+        memory["control_points"] = len(cp)
+        if not len(cp):
+            return jacs, refs, weights
+        cp_refs = combine(cp.interpolate(refs) / GRIPPER_SPEED, cp.w_ob, GRIPPER_SPEED)
+        return (
+            np.concatenate([jacs, cp.jacobians(jacs)]),
+            np.concatenate([refs, cp_refs]),
+            np.concatenate([weights, 1.0 + np.linalg.norm(cp.w_ob, axis=1)]),
+        )
 
 
 class ExtendedPotentialFieldPolicy(PotentialFieldPolicy):
-    """The paper's method with our two extensions of eq. 9-10.
+    """The paper's method plus our "vortex" escape from local minima of the path."""
 
-    A link's obstacle terms also go to its distal point, and they also act on
-    obstacles beyond the link's ends (closest point of the segment).
-    """
-
-    interior_only = False
-    both_ends = True
+    default_escape = True
 
 
 class ResolvedRatePolicy(_ArmPolicy):

@@ -25,9 +25,30 @@ Choices where the paper is silent: ``rho`` is the *surface clearance*
 (centre distance minus the obstacle's radius and the gripper link's radius;
 the paper's obstacles are points and lines, for which the two agree), floored
 at 1 mm; a bar's shortest distance is to the closest point of its segment.
-Local minima: see :func:`plan_path` (our stand-in for the paper's
-undescribed "virtual plane concept"); past the path's end the policy drives
-straight to the fruit, as the paper's program always did.
+Past the path's end the policy drives straight to the fruit, as the
+paper's program always did.
+
+The virtual plane. The paper applies eq. 2-3 "together with the virtual
+plane concept" (section 3.1) and builds the reference velocities from "the
+obstacle information inside the set virtual plane" (section 3.2); the text
+that defined the plane did not survive. One statement that did fixes our
+reading: ``m`` = 0.4-1 was chosen "so that obstacles are avoided at about
+20-45 degrees"; ``atan(0.4)`` = 22 and ``atan(1)`` = 45 degrees, which is the
+angle of ``v`` only when the obstacle term (``m`` at ``rho = k rho0``) is
+*perpendicular* to the unit target term. So (``virtual_plane=True``) the
+plane passes through the gripper normal to its direction to the fruit, each
+obstacle acts through its projection onto that plane, and its term is the
+unit direction in the plane away from the projection, with the eq. 5
+magnitude of its true distance. An obstacle dead ahead (projection on the
+gripper) is passed on a fixed side (2-D: +90 degrees; 3-D: ``n x z``). The
+terms never oppose the target term, so ``v`` always has a positive part
+towards the fruit: the path cannot stall in a local minimum.
+``virtual_plane=False`` is the plain field of eq. 5 (terms along the shortest
+distance), which stalls where an obstacle lies between gripper and fruit.
+
+Local minima (an obstacle straight between gripper and fruit) are not
+treated by the paper; :func:`plan_path`'s ``escape`` is our addition,
+separately named and off in the paper's policy.
 """
 
 from __future__ import annotations
@@ -91,13 +112,16 @@ def field_direction(
     trajectory: FieldParameters = TRAJECTORY,
     target: FieldParameters = TARGET,
     vortex: bool = False,
+    virtual_plane: bool = True,
 ) -> np.ndarray:
     """Eq. 7's unit direction ``v`` at gripper position ``x`` (dim,).
 
     Obstacles are segments ``a``-``b`` (K, dim) of ``radius`` (K,); a sphere
     has ``a == b``. ``vortex`` turns each obstacle term 45 degrees from
     "away" towards the way around the obstacle to the fruit (our escape from
-    local minima, see :func:`plan_path`).
+    local minima, see :func:`plan_path`). ``virtual_plane``: each obstacle
+    term lies in the plane through ``x`` normal to the fruit direction (see
+    the module docstring).
     """
     to_fruit = fruit - x
     d = float(np.linalg.norm(to_fruit))
@@ -109,11 +133,29 @@ def field_direction(
         rho = dist - radius - gripper_radius
         mag = obstacle_magnitude(rho, trajectory)  # (K,)
         away = (x - closest) / np.maximum(dist, 1e-12)[:, None]  # (K, dim)
+        if virtual_plane:
+            away = _in_plane(away, to_fruit / d)
         if vortex:
             away = _around(away, to_fruit / d)
         v = v + (mag[:, None] * away).sum(axis=0)
     n = float(np.linalg.norm(v))
     return v / n if n > 1e-12 else np.zeros_like(x)
+
+
+def _side(n: np.ndarray) -> np.ndarray:
+    """A fixed unit direction perpendicular to unit ``n`` (dim,)."""
+    if len(n) == 2:
+        return np.array([-n[1], n[0]])
+    axis = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    side = np.cross(n, axis)
+    return side / np.linalg.norm(side)
+
+
+def _in_plane(away: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Unit part of each ``away`` (K, dim) in the plane normal to unit ``n`` (the virtual plane)."""
+    perp = away - (away @ n)[:, None] * n[None, :]  # (K, dim)
+    norm = np.linalg.norm(perp, axis=1, keepdims=True)
+    return np.where(norm > 1e-6, perp / np.maximum(norm, 1e-12), _side(n)[None, :])
 
 
 def _around(away: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -143,6 +185,8 @@ def plan_path(
     tolerance: float = 0.005,
     max_steps: int = 1000,
     escape: bool = True,
+    virtual_plane: bool = True,
+    report: dict | None = None,
 ) -> np.ndarray:
     """RK4 integral of eq. 7 from ``start`` to ``fruit``: path points (N, dim).
 
@@ -151,25 +195,30 @@ def plan_path(
     the fruit when the path arrives within ``tolerance``.
 
     A potential field has local minima (an obstacle straight between the
-    gripper and the fruit, common in the plane). The paper pairs the field
-    with a "virtual plane concept" that its text does not describe; our
-    stand-in: when the path stalls (less than 1 mm closer to the fruit over
-    50 steps), the stalled steps are dropped and the obstacle terms turn 45
-    degrees towards the way around each obstacle (``vortex``) until the path
-    is 0.1 m closer to the fruit than where it stalled (at most 150 steps, 5
-    times); then eq. 7 resumes. ``escape=False`` stops at the first stall
-    (the policy then drives straight at the fruit, as the paper's program
-    always did).
+    gripper and the fruit, common in the plane) that the paper does not
+    treat. Our addition, ``escape`` (the "vortex" escape): when the path
+    stalls (less than 1 mm closer to the fruit over 50 steps), the stalled
+    steps are dropped and the obstacle terms turn 45 degrees towards the way
+    around each obstacle (``vortex``) until the path is 0.1 m closer to the
+    fruit than where it stalled (at most 150 steps, 5 times); then eq. 7
+    resumes. ``escape=False`` stops at the first stall (the policy then
+    drives straight at the fruit, as the paper's program
+    always did). ``virtual_plane``: see the module docstring. ``report``, if
+    given, receives ``stalled`` (bool) and ``escapes`` (escapes used).
     """
     x = np.asarray(start, float).copy()
     fruit = np.asarray(fruit, float)
 
     def f(p: np.ndarray, vortex: bool) -> np.ndarray:
-        return speed * field_direction(p, fruit, a, b, radius, gripper_radius, vortex=vortex)
+        return speed * field_direction(
+            p, fruit, a, b, radius, gripper_radius, vortex=vortex, virtual_plane=virtual_plane
+        )
 
     path = [x.copy()]
     h = step
-    vortex, since, escapes, d_stall, vortex_steps = False, 0, 5 if escape else 0, 0.0, 0
+    budget = 5 if escape else 0
+    vortex, since, escapes, d_stall, vortex_steps = False, 0, budget, 0.0, 0
+    stalled = False
     for _ in range(max_steps):
         d = float(np.linalg.norm(fruit - x))
         if d <= max(tolerance, speed * h):
@@ -190,6 +239,7 @@ def plan_path(
             and since > 50
             and np.linalg.norm(fruit - path[-51]) - np.linalg.norm(fruit - x) < 1e-3
         ):  # stalled in a local minimum
+            stalled = True
             if escapes == 0:
                 break
             del path[-50:]
@@ -198,4 +248,6 @@ def plan_path(
             d_stall = float(np.linalg.norm(fruit - x))
     if np.linalg.norm(fruit - x) <= max(tolerance, speed * h):
         path.append(fruit.copy())
+    if report is not None:
+        report["stalled"], report["escapes"] = stalled, budget - escapes
     return np.array(path)

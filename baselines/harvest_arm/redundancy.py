@@ -13,7 +13,8 @@ reference velocity and ``k_i > 0`` its weight. This is the exact solution of
 (Lagrange: ``S1 theta_dot - S2 + Jn^T lambda = 0``). Robustness, our choices:
 
 * ``S1`` is singular when a joint moves none of the weighted points; we add
-  ``reg * trace(S1) / n`` to its diagonal (``reg = 1e-9`` by default). The
+  ``reg * trace(S1) / n`` to its diagonal (``reg = 1e-9`` by default; the
+  policy uses 1e-3, see :data:`..policy.JOINT_DAMPING`). The
   policy also weights the gripper itself (its reference velocity is
   ``X_dot``), which changes nothing in the constrained solution.
 * Near a singular ``Jn``, ``M = Jn S1^-1 Jn^T`` loses rank; we damp it,
@@ -71,8 +72,12 @@ def limited_rates(
     limits: np.ndarray,
     speeds: np.ndarray,
     dt: float,
+    reg: float = 1e-9,
 ) -> np.ndarray:
-    """Eq. 1 within joint ranges ``+-limits`` (n,) and speed limits (n,): theta_dot (n,)."""
+    """Eq. 1 within joint ranges ``+-limits`` (n,) and speed limits (n,): theta_dot (n,).
+
+    ``reg`` as in :func:`weighted_rates`.
+    """
     n = len(q)
     low = (-limits - q) / dt  # rates that reach a limit within dt
     high = (limits - q) / dt
@@ -84,7 +89,7 @@ def limited_rates(
             break
         x_rest = x_dot - jn[:, ~free] @ held[~free]
         ref_rest = refs - jacs[:, :, ~free] @ held[~free]
-        sol = weighted_rates(jn[:, free], x_rest, jacs[:, :, free], ref_rest, weights)
+        sol = weighted_rates(jn[:, free], x_rest, jacs[:, :, free], ref_rest, weights, reg)
         rates = held.copy()
         rates[free] = sol
         scale = min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))

@@ -3,7 +3,9 @@
 Two IDs cover the paper's six arms: ``motiongym/HarvestArm-v0`` (spatial,
 ``dof`` 5, 6 or 7, default 7; 10 obstacles, 3 bars) and
 ``motiongym/HarvestArmPlanar-v0`` (planar, ``dof`` 3, 4 or 5, default 5; 8
-obstacles). See :class:`motiongym.envs.harvest_arm.env.HarvestArmEnv`.
+obstacles). ``-v1`` of each also counts self-collision (two non-adjacent
+links touching) as a collision. See
+:class:`motiongym.envs.harvest_arm.env.HarvestArmEnv`.
 """
 
 from __future__ import annotations
@@ -20,5 +22,17 @@ REGISTRATIONS: tuple[dict, ...] = (
         "entry_point": "motiongym.envs.harvest_arm.env:HarvestArmEnv",
         "max_episode_steps": 300,
         "kwargs": {"dof": 5, "planar": True},
+    },
+    {
+        "id": "motiongym/HarvestArm-v1",
+        "entry_point": "motiongym.envs.harvest_arm.env:HarvestArmEnv",
+        "max_episode_steps": 300,
+        "kwargs": {"dof": 7, "planar": False, "self_collision": True},
+    },
+    {
+        "id": "motiongym/HarvestArmPlanar-v1",
+        "entry_point": "motiongym.envs.harvest_arm.env:HarvestArmEnv",
+        "max_episode_steps": 300,
+        "kwargs": {"dof": 5, "planar": True, "self_collision": True},
     },
 )

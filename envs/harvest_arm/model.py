@@ -141,6 +141,7 @@ def build_model(
     n_spheres: int,
     n_bars: int,
     dt: float,
+    self_pairs: bool = False,
 ) -> tuple[mujoco.MjModel, dict[str, np.ndarray]]:
     """The MuJoCo model: arm bodies, link capsules, obstacle slots, the fruit.
 
@@ -149,11 +150,40 @@ def build_model(
     5 m margin, so ``mj_collision`` reports the exact signed distance of every
     pair each step (MuJoCo's analytic sphere-capsule and capsule-capsule
     tests) while nothing moves under contact forces (the arm is kinematic).
+    ``self_pairs`` adds, after those, one pair per two non-adjacent links
+    (no shared joint point) with the same margin: their signed distances
+    measure self-collision.
 
     Returns:
         the compiled model and index arrays: ``link_geoms`` (L,),
-        ``obstacle_geoms`` (K,), ``point_sites`` (P,), ``fruit_geom`` (1,).
+        ``obstacle_geoms`` (K,), ``point_sites`` (P,), ``fruit_geom`` (1,),
+        ``self_pairs`` (S, 2) link indices of the self pairs (S = 0 without).
     """
+    s = _scene_spec(spec, dt)
+    point_sites, link_geoms = _add_arm(s, spec, link_radius)
+    obstacle_geoms = _add_obstacles(s, n_spheres, n_bars)
+    for link in link_geoms:
+        for obstacle in obstacle_geoms:
+            s.add_pair(geomname1=link, geomname2=obstacle, margin=5.0)
+    n_links = len(link_geoms)
+    pairs = [(i, j) for i in range(n_links) for j in range(i + 2, n_links)] if self_pairs else []
+    for i, j in pairs:
+        s.add_pair(geomname1=link_geoms[i], geomname2=link_geoms[j], margin=5.0)
+    model = s.compile()
+    for name in obstacle_geoms:  # moved and turned at reset: never assume the body's frame
+        model.geom_sameframe[model.geom(name).id] = mujoco.mjtSameFrame.mjSAMEFRAME_NONE
+    index = {
+        "link_geoms": np.array([model.geom(g).id for g in link_geoms]),
+        "obstacle_geoms": np.array([model.geom(g).id for g in obstacle_geoms], dtype=int),
+        "point_sites": np.array([model.site(p).id for p in point_sites]),
+        "fruit_geom": np.array([model.geom("fruit").id]),
+        "self_pairs": np.array(pairs, dtype=int).reshape(-1, 2),
+    }
+    return model, index
+
+
+def _scene_spec(spec: ArmSpec, dt: float) -> mujoco.MjSpec:
+    """An empty scene: options, light, the ground."""
     s = mujoco.MjSpec()
     s.modelname = f"harvest_{spec.name}"
     s.option.timestep = dt
@@ -171,6 +201,11 @@ def build_model(
         contype=0,
         conaffinity=0,
     )
+    return s
+
+
+def _add_arm(s: mujoco.MjSpec, spec: ArmSpec, link_radius: float) -> tuple[list[str], list[str]]:
+    """The arm's bodies, joints, link capsules and point sites: (site names, link names)."""
     point_starts = set(joint_points(spec))
     parent = s.worldbody
     point_sites: list[str] = []
@@ -201,29 +236,22 @@ def build_model(
         name="gripper", pos=list(spec.tool), size=[0.015, 0, 0], rgba=[0.9, 0.5, 0.1, 1]
     )
     point_sites.append("gripper")
+    return point_sites, link_geoms
 
+
+def _add_obstacles(s: mujoco.MjSpec, n_spheres: int, n_bars: int) -> list[str]:
+    """Obstacle slots (spheres, then bar capsules) and the fruit, parked far away."""
     obstacle_geoms = []
     far = [0.0, 0.0, -100.0]
-    for k in range(n_spheres):
-        name = f"sphere{k}"
+    for k in range(n_spheres + n_bars):
+        bar = k >= n_spheres
+        name = f"bar{k - n_spheres}" if bar else f"sphere{k}"
         s.worldbody.add_geom(
             name=name,
-            type=mujoco.mjtGeom.mjGEOM_SPHERE,
-            size=[0.02, 0, 0],
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE if bar else mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[0.01, 0.1, 0] if bar else [0.02, 0, 0],
             pos=far,
-            rgba=[0.45, 0.75, 0.25, 1.0],
-            contype=0,
-            conaffinity=0,
-        )
-        obstacle_geoms.append(name)
-    for k in range(n_bars):
-        name = f"bar{k}"
-        s.worldbody.add_geom(
-            name=name,
-            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-            size=[0.01, 0.1, 0],
-            pos=far,
-            rgba=[0.45, 0.3, 0.15, 1.0],
+            rgba=[0.45, 0.3, 0.15, 1.0] if bar else [0.45, 0.75, 0.25, 1.0],
             contype=0,
             conaffinity=0,
         )
@@ -237,19 +265,7 @@ def build_model(
         contype=0,
         conaffinity=0,
     )
-    for link in link_geoms:
-        for obstacle in obstacle_geoms:
-            s.add_pair(geomname1=link, geomname2=obstacle, margin=5.0)
-    model = s.compile()
-    for name in obstacle_geoms:  # moved and turned at reset: never assume the body's frame
-        model.geom_sameframe[model.geom(name).id] = mujoco.mjtSameFrame.mjSAMEFRAME_NONE
-    index = {
-        "link_geoms": np.array([model.geom(g).id for g in link_geoms]),
-        "obstacle_geoms": np.array([model.geom(g).id for g in obstacle_geoms], dtype=int),
-        "point_sites": np.array([model.site(p).id for p in point_sites]),
-        "fruit_geom": np.array([model.geom("fruit").id]),
-    }
-    return model, index
+    return obstacle_geoms
 
 
 def _add_link(body: mujoco.MjsBody, name: str, end: tuple[float, ...], radius: float) -> str:

@@ -29,11 +29,14 @@ Everything is drawn from the ``rng`` passed in (the env's ``np_random``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from motiongym.envs.core import ArgumentError, check_float, check_shape
 from motiongym.envs.geometry import closest_point_on_segment, closest_points_between_segments
 from motiongym.envs.harvest_arm.model import REACH, ArmKinematics
+from motiongym.envs.harvest_arm.observation import POSITION_BOUND
 
 FRUIT_RADIUS = 0.035  # m
 SPHERE_RADIUS = (0.01, 0.02)  # m, immature fruit
@@ -66,38 +69,64 @@ class Scene:
         return len(self.radius)
 
 
-def scene_from_obstacles(fruit: np.ndarray, obstacles: list[dict], dim: int) -> Scene:
-    """A scene from explicit obstacles ``{"center", "radius"}`` or ``{"a", "b", "radius"}``."""
-    fruit = np.asarray(fruit, float).reshape(-1)
-    if fruit.shape != (dim,):
-        raise ValueError(f"fruit must have {dim} coordinates, got shape {fruit.shape}")
-    a, b, r, bar = [], [], [], []
+def check_position(name: str, value: Any, dim: int) -> np.ndarray:
+    """A finite point (dim,) within +-``POSITION_BOUND`` m (the observation's bounds)."""
+    point = check_shape(name, value, (dim,))
+    if np.abs(point).max() > POSITION_BOUND:
+        raise ArgumentError(
+            f"{name} must lie within +-{POSITION_BOUND} m on every axis, got {value!r}"
+        )
+    return point
+
+
+def scene_from_obstacles(
+    fruit: Any, obstacles: Any, dim: int, slots: tuple[int, int] | None = None
+) -> Scene:
+    """A scene from explicit obstacles ``{"center", "radius"}`` or ``{"a", "b", "radius"}``.
+
+    Every coordinate finite and within +-2 m, every radius in (0, 0.2] m, at
+    most ``slots`` = (spheres, bars), and no obstacle overlapping the fruit
+    sphere: otherwise an :class:`ArgumentError` naming the obstacle.
+    """
+    fruit = check_position("options['fruit']", fruit, dim)
+    if not isinstance(obstacles, (list, tuple)):
+        raise ArgumentError(f"options['obstacles'] must be a list of dicts, got {obstacles!r}")
+    a, b, r = [], [], []
     for i, ob in enumerate(obstacles):
-        keys = set(ob)
+        name = f"options['obstacles'][{i}]"
+        keys = set(ob) if isinstance(ob, dict) else None
         if keys == {"center", "radius"}:
-            c = np.asarray(ob["center"], float)
-            a.append(c)
-            b.append(c)
-            bar.append(False)
+            a.append(check_position(f"{name}['center']", ob["center"], dim))
+            b.append(a[-1])
         elif keys == {"a", "b", "radius"}:
-            a.append(np.asarray(ob["a"], float))
-            b.append(np.asarray(ob["b"], float))
-            bar.append(True)
+            a.append(check_position(f"{name}['a']", ob["a"], dim))
+            b.append(check_position(f"{name}['b']", ob["b"], dim))
         else:
-            raise ValueError(
-                f"obstacle {i} has keys {sorted(keys)}; expected "
-                "{'center', 'radius'} (sphere) or {'a', 'b', 'radius'} (bar)"
+            raise ArgumentError(
+                f"{name} must be a dict with keys {{'center', 'radius'}} (sphere) or "
+                f"{{'a', 'b', 'radius'}} (bar), got {ob!r}"
             )
-        if a[-1].shape != (dim,) or b[-1].shape != (dim,):
-            raise ValueError(f"obstacle {i} points must have {dim} coordinates")
-        r.append(float(ob["radius"]))
-    return Scene(
-        fruit,
-        np.array(a, float).reshape(-1, dim),
-        np.array(b, float).reshape(-1, dim),
-        np.array(r, float),
-        np.array(bar, bool),
-    )
+        r.append(check_float(f"{name}['radius']", ob["radius"], 0.0, 0.2, low_open=True))
+    is_bar = np.array(["a" in ob for ob in obstacles], bool)
+    scene = Scene(
+        fruit, np.array(a, float).reshape(-1, dim), np.array(b, float).reshape(-1, dim),
+        np.array(r, float), is_bar,
+    )  # fmt: skip
+    n_bars = int(is_bar.sum())
+    if slots is not None and (len(scene) - n_bars > slots[0] or n_bars > slots[1]):
+        raise ArgumentError(
+            f"options['obstacles'] must hold at most {slots[0]} spheres and {slots[1]} bars "
+            f"(the env's slots), got {len(scene) - n_bars} spheres and {n_bars} bars"
+        )
+    if len(scene):
+        gap = closest_point_on_segment(fruit, scene.a, scene.b)[0] - scene.radius - FRUIT_RADIUS
+        if (gap < 0.0).any():
+            i = int(np.argmin(gap))
+            raise ArgumentError(
+                f"options['obstacles'][{i}] must not overlap the fruit (radius {FRUIT_RADIUS} m), "
+                f"got a surface gap of {gap[i]:.3f} m"
+            )
+    return scene
 
 
 def solve_ik(
@@ -137,6 +166,23 @@ def clearance_to_arm(points: np.ndarray, link_radius: float, scene: Scene) -> np
     return dist.min(axis=0) - link_radius - scene.radius
 
 
+def _sample_fruit(rng: np.random.Generator, kin: ArmKinematics, start: np.ndarray) -> np.ndarray:
+    """The first reachable fruit candidate in draw order, in batches (dim,)."""
+    planar = kin.spec.planar
+    fruit_box = PLANAR_FRUIT_BOX if planar else SPATIAL_FRUIT_BOX
+    home = np.array(kin.spec.home)
+    root = start[0] if planar else start[1]
+    for _ in range(20):
+        cand = rng.uniform(fruit_box[0], fruit_box[1], size=(_BATCH, kin.dim))
+        ok = (np.linalg.norm(cand - start[-1], axis=1) >= MIN_TRAVEL) & (
+            np.linalg.norm(cand - root, axis=1) <= MAX_REACH
+        )
+        for c in cand[ok]:
+            if solve_ik(kin, c, home)[1] < 2e-3:
+                return c
+    raise RuntimeError("no reachable fruit found in 20 batches")  # pragma: no cover
+
+
 def sample_scene(
     rng: np.random.Generator,
     kin: ArmKinematics,
@@ -147,25 +193,9 @@ def sample_scene(
     """Sample a scene as documented in the module docstring."""
     planar = kin.spec.planar
     box = PLANAR_BOX if planar else SPATIAL_BOX
-    fruit_box = PLANAR_FRUIT_BOX if planar else SPATIAL_FRUIT_BOX
     dim = kin.dim
-    home = np.array(kin.spec.home)
-    start = kin.forward(home)  # (P, dim)
-    root = start[0] if planar else start[1]
-    fruit = None
-    for _ in range(20):  # batches of candidates; the first reachable one in draw order
-        cand = rng.uniform(fruit_box[0], fruit_box[1], size=(_BATCH, dim))
-        ok = (np.linalg.norm(cand - start[-1], axis=1) >= MIN_TRAVEL) & (
-            np.linalg.norm(cand - root, axis=1) <= MAX_REACH
-        )
-        for c in cand[ok]:
-            if solve_ik(kin, c, home)[1] < 2e-3:
-                fruit = c
-                break
-        if fruit is not None:
-            break
-    else:  # pragma: no cover - the fruit box lies well inside the reach
-        raise RuntimeError("no reachable fruit found in 20 batches")
+    start = kin.forward(np.array(kin.spec.home))  # (P, dim)
+    fruit = _sample_fruit(rng, kin, start)
     low, high = np.maximum(box[0], fruit - CLUSTER), np.minimum(box[1], fruit + CLUSTER)
     parts = []
     for count, bars in ((n_obstacles - n_bars, False), (n_bars, True)):

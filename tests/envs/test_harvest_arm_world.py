@@ -80,9 +80,10 @@ def test_clearances_match_numpy_geometry_and_mj_geom_distance():
         np.testing.assert_allclose(o["distances"], expected, atol=1e-6)
         assert scene.is_bar.sum() == 3
         fromto = np.zeros(6)
-        for li, lg in enumerate(env.index["link_geoms"]):
-            for k, og in enumerate(env.index["obstacle_geoms"]):
-                d = mujoco.mj_geomDistance(env.model, env.data, lg, og, 10.0, fromto)
+        world = env.world
+        for li, lg in enumerate(world.index["link_geoms"]):
+            for k, og in enumerate(world.index["obstacle_geoms"]):
+                d = mujoco.mj_geomDistance(world.model, world.data, lg, og, 10.0, fromto)
                 assert min(d, 1.0) == pytest.approx(expected[li, k], abs=1e-6)
 
 
@@ -174,22 +175,68 @@ def test_same_seed_same_scene_and_trajectory():
 
 
 def test_bad_input_is_rejected_with_the_valid_choices():
-    with pytest.raises(ValueError, match=r"\(5, 6, 7\)"):
+    with pytest.raises(ValueError, match=r"dof must be an integer in \[5, 7\], got 4"):
         _make(False, 4)
-    with pytest.raises(ValueError, match=r"\(3, 4, 5\)"):
+    with pytest.raises(ValueError, match=r"dof must be an integer in \[3, 5\], got 7"):
         _make(True, 7)
+    bad_kwargs = [
+        ({"dof": 5.5}, "dof must be an integer"),
+        ({"planar": "no"}, "planar must be True or False, got 'no'"),
+        ({"link_radius": 0.0}, r"link_radius must be a finite number in \(0.0, 0.1\]"),
+        ({"dt": float("nan")}, "dt must be a finite number"),
+        ({"safety_distance": 0}, "safety_distance must be"),
+        ({"n_obstacles": 10**5}, r"n_obstacles must be an integer in \[1, 32\]"),
+        ({"n_bars": 11}, r"n_bars must be an integer in \[0, 10\]"),
+        ({"collision": float("inf")}, "collision must be a finite number"),
+        ({"self_collision": 1}, "self_collision must be True or False"),
+        ({"render_mode": "depth"}, "render_mode must be one of"),
+        ({"width": 0}, "width must be an integer"),
+    ]
+    for kwargs, message in bad_kwargs:
+        with pytest.raises(ValueError, match=message):
+            gym.make("motiongym/HarvestArm-v1", **kwargs)
     env = _make(True, 3)
     with pytest.raises(ValueError, match="valid"):
         env.reset(options={"start": 1})
+    with pytest.raises(ValueError, match="None or a dict"):
+        env.reset(options="notadict")
     with pytest.raises(ValueError, match="together"):
         env.reset(options={"fruit": [0.5, 0.0]})
     with pytest.raises(ValueError, match="keys"):
         env.reset(options={"fruit": [0.5, 0.0], "obstacles": [{"centre": [0, 0], "radius": 1}]})
+    nan_obstacle = [{"center": [np.nan, 0.1], "radius": 0.02}]
+    with pytest.raises(ValueError, match=r"options\['obstacles'\]\[0\]\['center'\] must be finite"):
+        env.reset(options={"fruit": [0.5, 0.0], "obstacles": nan_obstacle})
+    with pytest.raises(ValueError, match=r"options\['q'\] must be finite"):
+        env.reset(options={"q": [np.nan, 0.0, 0.0]})
+    inside = [{"center": [0.51, 0.0], "radius": 0.02}]
+    with pytest.raises(ValueError, match=r"\[0\] must not overlap the fruit"):
+        env.reset(options={"fruit": [0.5, 0.0], "obstacles": inside})
+    too_many = [{"center": [0.1 * i, 0.5], "radius": 0.01} for i in range(9)]
+    with pytest.raises(ValueError, match="at most 8 spheres and 0 bars"):
+        env.reset(options={"fruit": [0.5, 0.0], "obstacles": too_many})
     env.reset(seed=0)
     with pytest.raises(ValueError, match="shape"):
         env.step(np.zeros(4))
     with pytest.raises(ValueError, match="finite"):
         env.step(np.array([np.nan, 0, 0]))
+    with pytest.raises(RuntimeError, match="reset"):
+        _make(True, 3).unwrapped.step(np.zeros(3, np.float32))
+
+
+def test_an_unreachable_fruit_ends_by_the_time_limit():
+    """Documented outcome: accepted, the episode truncates unsuccessfully (no hang)."""
+    from motiongym.agents.evaluate import run_episode
+    from motiongym.baselines import make_policy
+
+    env = gym.make("motiongym/HarvestArmPlanar-v1", dof=3)
+    policy = make_policy(
+        "motiongym/HarvestArmPlanar-v1", "potential-field", env.observation_space,
+        env.action_space, {"dof": 3, "planar": True},
+    )  # fmt: skip
+    options = {"fruit": [1.5, 1.5], "obstacles": [{"center": [0.4, 0.4], "radius": 0.02}]}
+    result = run_episode(env, policy, seed=0, options=options)
+    assert result["length"] == 300 and not result["is_success"]
 
 
 def test_render_rgb_array_shows_the_scene():
@@ -204,3 +251,64 @@ def test_render_rgb_array_shows_the_scene():
     assert frame.shape == (120, 160, 3)
     assert frame.std() > 5
     env.close()
+
+
+@pytest.mark.parametrize(("planar", "dof"), ARMS)
+def test_v1_self_distance_is_the_brute_force_distance_of_non_adjacent_links(planar, dof):
+    """MuJoCo's link-link pairs against segment distances of our own joint points."""
+    env_id = "motiongym/HarvestArmPlanar-v1" if planar else "motiongym/HarvestArm-v1"
+    env = gym.make(env_id, dof=dof, terminate_on_collision=False)
+    base = env.unwrapped
+    kin = ArmKinematics(base.spec_arm)
+    rng = np.random.default_rng(dof + 10 * planar)
+    limits = base.spec_arm.limits
+    r = base.link_radius
+    seen_collision = seen_clear = 0
+    for _ in range(60):
+        q = rng.uniform(-limits, limits)
+        _, info = env.reset(seed=1, options={"q": q})
+        _, _, _, _, info = env.step(np.zeros(dof, dtype=np.float32))
+        points = kin.forward(q)
+        p0, p1 = points[:-1], points[1:]
+        brute = min(
+            float(closest_points_between_segments(p0[i], p1[i], p0[j], p1[j])[0]) - 2 * r
+            for i in range(len(p0))
+            for j in range(i + 2, len(p0))
+        )
+        assert info["self_distance"] == pytest.approx(min(brute, 1.0), abs=1e-6)
+        assert info["self_collision"] == (brute <= 0.0)
+        if brute <= 0.0:
+            seen_collision += 1
+            assert info["collision"] and info["cost"] == 1.0
+            assert info["reward_collision"] == -base.weights["collision"]
+        else:
+            seen_clear += 1
+    assert seen_clear > 0
+    if planar:  # random planar poses fold the arm onto itself often
+        assert seen_collision > 0
+
+
+def test_v1_terminates_on_self_collision_and_v0_ignores_it():
+    """A planar 5-DOF arm folded back onto itself, no obstacle near."""
+    q = np.array([0.0, 2.6, 2.6, 2.6, 0.0])
+    far = [{"center": [0.8, 0.5], "radius": 0.01}]
+    options = {"q": q, "fruit": np.array([0.5, -0.4]), "obstacles": far}
+    v1 = gym.make("motiongym/HarvestArmPlanar-v1")
+    v1.reset(seed=0, options=options)
+    _, _, terminated, _, info = v1.step(np.zeros(5, dtype=np.float32))
+    assert info["self_collision"] and info["collision"] and terminated
+    v0 = gym.make("motiongym/HarvestArmPlanar-v0")
+    v0.reset(seed=0, options=options)
+    _, _, terminated, _, info = v0.step(np.zeros(5, dtype=np.float32))
+    assert not info["collision"] and not terminated and "self_collision" not in info
+
+
+def test_docstring_table_is_the_default_arms_layout():
+    env = gym.make("motiongym/HarvestArm-v1").unwrapped
+    table = env.layout.table()
+    doc = "\n".join(line.strip() for line in type(env).__doc__.splitlines())
+    assert "\n".join(line.strip() for line in table.splitlines()) in doc
+    observation, _ = env.reset(seed=0)
+    assert set(env.layout.parse(observation)) >= {"q", "points", "distances"}
+    with pytest.raises(ValueError, match="shape"):
+        env.layout.parse(observation[:-1])  # the fields cover the whole vector
