@@ -14,6 +14,7 @@ from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import evaluate
 from motiongym.agents.predictors import SampledModel, load_predictor
+from motiongym.agents.pretrained import write_manifest
 from motiongym.agents.train import train
 
 SWEEPER = "motiongym/Sweeper-v0"
@@ -40,6 +41,9 @@ def test_a_sampling_run_acts_the_same_on_the_same_seed(tmp_path):
     # The same model on its most likely actions is another policy.
     resolved = yaml.safe_load((run_dir / "config.yml").read_text())
     (run_dir / "config.yml").write_text(yaml.safe_dump({**resolved, "deterministic": True}))
+    with pytest.raises(UsageError, match="SHA-256"):  # the run's manifest sees the edit
+        load_predictor(str(run_dir), SWEEPER, env)
+    write_manifest(run_dir)  # the user vouches for the edited run
     greedy = load_predictor(str(run_dir), SWEEPER, env)
     assert not isinstance(greedy, SampledModel)
     assert evaluate(env, greedy, [7, 8], SWEEPER, "greedy", progress=False).episodes != sampled
