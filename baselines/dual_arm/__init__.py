@@ -14,3 +14,4 @@ POLICIES: dict[str, dict[str, str]] = {
         "undelayed": f"{_MODULE}:UndelayedPolicy",
     },
 }
+POLICIES["motiongym/DualArmCell-v1"] = dict(POLICIES["motiongym/DualArmCell-v0"])

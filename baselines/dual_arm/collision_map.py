@@ -28,7 +28,8 @@ from collections.abc import Callable
 import numpy as np
 
 from motiongym.envs.dual_arm import model
-from motiongym.envs.dual_arm.task import Trajectory
+from motiongym.envs.dual_arm.motion import body_motion, configs, spans_collide, variation
+from motiongym.envs.dual_arm.task import DT, Trajectory
 
 CellFunction = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -66,9 +67,30 @@ class CollisionMap:
 
     @classmethod
     def from_tasks(
-        cls, traj1: Trajectory, traj2: Trajectory, n_levels: int = 100, margin: float = 0.0
+        cls,
+        traj1: Trajectory,
+        traj2: Trajectory,
+        n_levels: int = 100,
+        margin: float = 0.0,
+        swept: bool = False,
     ) -> CollisionMap:
-        """The map of two arms' tasks (the link geometry of ``envs.dual_arm.model``)."""
+        """The map of two arms' tasks (the link geometry of ``envs.dual_arm.model``).
+
+        ``swept=False``: the paper's cells, one configuration each (robot 1 at
+        sample ``s1``, robot 2 at the level's floor). ``swept=True``: each
+        cell stands for a motion and is blocked when *any* configuration of it
+        comes within ``margin`` (certified, :func:`motion.spans_collide`):
+        robot 1 over its samples ``[s1, s1 + 1]``, robot 2 over the samples in
+        which its wrist travels from ``s2 dl`` to ``(s2 + 1) dl``, both on the
+        straight joint-space moves between samples that the environment makes.
+        Every step of a delayed TLVST curve (column ``D + k``: robot 1 from
+        sample ``D + k`` to the next, robot 2 from ``k`` to ``k + 1``, whose
+        length runs from ``>= tl[k] dl`` to ``< (tl[k + 1] + 1) dl``) lies in
+        the union of the curve's cells in that column, so a delay whose curve
+        is free on this map never collides, between samples included.
+        """
+        if swept:
+            return cls._swept(traj1, traj2, n_levels, margin)
         q1 = traj1.samples()  # (N1 + 1, 6)
         q2, tl, _ = traj2.length_parametrised(n_levels)  # (N_l + 1, 6), (N2 + 1,)
         a1, b1 = model.link_segments(q1, model.base_transform(0))  # (N1+1, 5, 3)
@@ -78,6 +100,41 @@ class CollisionMap:
             return model.segments_collide(a1[s1], b1[s1], a2[s2], b2[s2], margin)
 
         return cls(cells, traj1.n_samples, tl, n_levels)
+
+    @classmethod
+    def _swept(
+        cls, traj1: Trajectory, traj2: Trajectory, n_levels: int, margin: float
+    ) -> CollisionMap:
+        samples1, samples2 = traj1.samples(), traj2.samples()
+        n1 = traj1.n_samples
+        _, tl, _ = traj2.length_parametrised(n_levels)
+        tau = traj2.level_times(n_levels) / DT  # (N_l + 1,) fractional samples
+        pad = 1e-6  # samples: covers the rounding of the TLVST levels
+        lo = np.maximum(tau - pad, 0.0)
+        hi = np.minimum(np.append(tau[1:], tau[-1]) + pad, traj2.n_samples)
+        # Corners and motion bounds of every cell's two moves, computed once.
+        ends1 = np.minimum(np.arange(n1 + 2), n1)  # robot 1's span [s1, s1 + 1], clamped
+        moves1 = body_motion(variation(samples1, ends1[:-1], ends1[1:]))  # (N1 + 1, 5)
+        moves2 = body_motion(variation(samples2, lo, hi))  # (N_l + 1, 5)
+        q2_lo, q2_hi = configs(samples2, lo), configs(samples2, hi)  # (N_l + 1, 6)
+
+        def cells(s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
+            s1 = np.minimum(s1, n1)
+            q1 = np.stack([samples1[ends1[s1]], samples1[ends1[s1 + 1]]])  # (2, n, 6)
+            q2 = np.stack([q2_lo[s2], q2_hi[s2]])  # (2, n, 6)
+            d = model.pair_distances(q1[:, None], q2[None, :])  # (2, 2, n, 5, 5)
+            hit = (d.min(axis=(-2, -1)) <= margin).any(axis=(0, 1))
+            slack = moves1[s1][:, :, None] / 2 + moves2[s2][:, None, :] / 2  # (n, 5, 5)
+            clear = (d - slack).min(axis=(0, 1, 3, 4)) > margin
+            out = hit.copy()
+            for i in np.flatnonzero(~hit & ~clear):  # near misses: halve until decided
+                a, b = int(s1[i]), int(s2[i])
+                out[i] = spans_collide(
+                    samples1, (ends1[a], ends1[a + 1]), samples2, (lo[b], hi[b]), margin
+                )
+            return out
+
+        return cls(cells, n1, tl, n_levels)
 
     @classmethod
     def from_array(cls, occupied: np.ndarray, tlvst: np.ndarray) -> CollisionMap:

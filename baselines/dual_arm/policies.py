@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from motiongym.baselines.dual_arm import schedules
+from motiongym.baselines.dual_arm import exact_delay, schedules
 from motiongym.baselines.dual_arm.boundary_following import boundary_following
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.policy import ScriptedPolicy
@@ -62,6 +62,8 @@ class SchedulePolicy(ScriptedPolicy):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
         self.safety_margin = float(self.env_kwargs.get("safety_margin", 0.0))
+        # v1 checks the motion between samples: plan on the swept (conservative) map.
+        self.swept = self.env_kwargs.get("collision_check", "samples") == "swept"
         self.margin = self.safety_margin + float(plan_margin)
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 
@@ -76,21 +78,44 @@ class SchedulePolicy(ScriptedPolicy):
     def _plan_verified(self, traj1, traj2, memory: dict[str, Any]) -> schedules.Schedule:
         margin = self.margin
         for replans in range(self.max_replans + 1):
-            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, margin)
+            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, margin, self.swept)
             plan = self.plan(cmap, memory)
             memory.update(map=cmap, margin=margin, replans=replans)
-            if not (self.verify and self.verifiable) or not schedules.collides_at_samples(
+            collides = schedules.collides_swept if self.swept else schedules.collides_at_samples
+            if not (self.verify and self.verifiable) or not collides(
                 traj1, traj2, plan.advances, self.safety_margin
             ):
                 return plan
             margin += self.replan_step
         memory["fallback"] = True
+        return self._fallback(traj1, traj2, cmap)
+
+    def _fallback(self, traj1, traj2, cmap: CollisionMap) -> schedules.Schedule:
+        """Sequential operation on v0; on v1 the exact minimum pure delay, which exists
+        whenever sequential operation is collision free (never sequential while a
+        shorter pure delay would do)."""
+        if self.swept:
+            delay = exact_delay.true_min_delay(traj1, traj2, self.safety_margin)
+            if delay is not None:
+                return schedules.delay_schedule(cmap, delay)
         return schedules.sequential(cmap)
+
+    def describe(self, memory: dict[str, Any]) -> dict[str, Any]:
+        """``delay`` (samples, None for a schedule that is not a pure delay), ``replans``
+        (how often the verification raised the map's margin), ``fallback`` (the plan
+        did not come from the policy's own method)."""
+        plan = memory.get("schedule")
+        return {
+            "delay": None if plan is None else plan.delay,
+            "replans": memory.get("replans", 0),
+            "fallback": bool(memory.get("fallback", False)),
+        }
 
     def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
         obs = np.asarray(observation, dtype=float)
         if memory["schedule"] is None:
-            memory["schedule"] = self._plan_verified(*tasks_from_observation(obs), memory)
+            memory["tasks"] = tasks_from_observation(obs)
+            memory["schedule"] = self._plan_verified(*memory["tasks"], memory)
         step = int(round(float(obs[OBS["elapsed"]][0]) / DT))
         adv = memory["schedule"].advances
         a2 = float(adv[step]) if step < len(adv) else 1.0
@@ -107,7 +132,7 @@ class BoundaryFollowingPolicy(SchedulePolicy):
         memory["result"] = result
         memory["fallback"] = result.delay is None
         if result.delay is None:
-            return schedules.sequential(cmap)
+            return self._fallback(*memory["tasks"], cmap)
         return schedules.delay_schedule(cmap, result.delay)
 
 
@@ -115,7 +140,10 @@ class ExhaustiveDelayPolicy(SchedulePolicy):
     """Minimum start delay by scanning every delay on the full map."""
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
-        delay = schedules.exhaustive_min_delay(cmap)
+        if self.swept:  # v1: the exact minimum on the environment's check, not on a map
+            delay = exact_delay.true_min_delay(*memory["tasks"], self.safety_margin)
+        else:
+            delay = schedules.exhaustive_min_delay(cmap)
         return schedules.delay_schedule(cmap, cmap.n1 if delay is None else delay)
 
 

@@ -16,6 +16,12 @@ REGISTRATIONS: tuple[dict, ...] = (
         "max_episode_steps": 1000,
         "kwargs": {"control": "both", "task": "colliding"},
     },
+    {
+        "id": "motiongym/DualArmCell-v1",
+        "entry_point": "motiongym.envs.dual_arm.env:DualArmCellEnv",
+        "max_episode_steps": 1000,
+        "kwargs": {"control": "both", "task": "colliding", "collision_check": "swept"},
+    },
 )
 
 

@@ -126,12 +126,8 @@ class Trajectory:
             each length level, and TLVST: the level index ``floor(l(k dt) / dl)``
             the wrist has reached at each sample ``k`` (last sample = ``N_l``).
         """
-        t, length = self.wrist_length()
-        total = float(length[-1])
-        # Strictly increasing in t so that the inverse is well defined at rests.
-        mono = length + 1e-12 * np.arange(len(length))
-        levels = np.linspace(0.0, mono[-1], n_levels + 1)
-        t_of_level = np.interp(levels, mono, t)
+        t, mono, total = self._monotone_length()
+        t_of_level = self.level_times(n_levels)
         q_levels = self.at_time(t_of_level)
         k_times = np.arange(self.n_samples + 1) * DT
         l_k = np.interp(k_times, t, mono)
@@ -139,6 +135,16 @@ class Trajectory:
         tl = np.clip(tl, 0, n_levels)
         tl[-1] = n_levels
         return q_levels, tl, total
+
+    def _monotone_length(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """``(times, lengths made strictly increasing, L_T)`` (the inverse is defined at rests)."""
+        t, length = self.wrist_length()
+        return t, length + 1e-12 * np.arange(len(length)), float(length[-1])
+
+    def level_times(self, n_levels: int) -> np.ndarray:
+        """(N_l + 1,) the time (s) at which the wrist has travelled ``s2 * L_T / N_l``."""
+        t, mono, _ = self._monotone_length()
+        return np.interp(np.linspace(0.0, mono[-1], n_levels + 1), mono, t)
 
     def compact(self) -> np.ndarray:
         """Flat compact form: vias (K * 6) then durations (K - 1)."""

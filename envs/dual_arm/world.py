@@ -98,6 +98,7 @@ class DualArmWorld(OwnsRenderer):
         self.tasks = (traj1, traj2)
         self.samples = (traj1.samples(), traj2.samples())  # (N_r + 1, 6) each
         self._deltas = tuple(np.diff(q, axis=0) for q in self.samples)  # (N_r, 6) each
+        self.slopes = tuple(np.abs(d) for d in self._deltas)  # (N_r, 6) |dq| per sample
         self.n1, self.n2 = float(traj1.n_samples), float(traj2.n_samples)
         self.p1 = self.p2 = 0.0
         self.steps = 0
