@@ -10,16 +10,18 @@ step), ``rotation`` (the base's ``R``, None when level) and
 1. hydraulics (:mod:`.hydraulics`): rate, acceleration and shared pump-flow
    limits turn the actions into joint rates; joints held in their ranges;
 2. the candidate pose's contact with the ground (:mod:`.digging`): no part
-   but the cutting edge may go deeper into the ground than it already is
-   (bucket shell, stick, boom, house: sample points on their bodies'
-   undersides); the edge may go deeper only while it cuts (moving within
-   60 deg of the opening's normal), against the earthmoving-equation
-   resistance. The step is cut short (bisection on the fraction of the step,
-   1/64) where the ground stops a part, and scaled by ``1 - F / F_dig``
-   while cutting; the joint rates are what was achieved;
+   but the cutting edge may enter the ground (bucket shell, stick, boom,
+   house: sample points on their bodies' undersides): a pose whose deepest
+   sample is more than 2 cm under the surface is allowed only while that
+   depth shrinks (a part already in the ground may only leave it); the edge
+   likewise, except while it cuts (moving within 60 deg of the opening's
+   normal), against the earthmoving-equation resistance. The step is cut
+   short (bisection on the fraction of the step, to 1/64) where the ground
+   stops a part, and scaled by ``1 - F / F_dig`` while cutting; the joint
+   rates are what was achieved;
 3. carving (the edge's sweep, bank volume times ``swell`` into the bucket,
-   a full bucket's surplus pushed ahead), pouring (as v0, the truck and the
-   bucket hold loose volume);
+   a full bucket's surplus pushed ahead), pouring (as v0, but not while the
+   edge is in the ground; the truck and the bucket hold loose volume);
 4. clearances of the collision bodies of :mod:`.bodies` (boom, stick,
    bucket with its full width and shell, house, tracks) to the pipe, the
    truck and each other (self-collision): exact below 1 m, a lower bound
@@ -173,16 +175,21 @@ class ExcavatorWorldV1(ExcavatorWorld):
         v = tuple(b - a for a, b in zip(pose0.tip, pose1.tip, strict=True))
         depth1 = self._edge_depth(pose1)
         cutting = self.carve and depth1 > 0.0 and cuts(v, pose1.n)
-        edge_limit = max(self._edge_depth(pose0), 0.0) + DEPTH_TOLERANCE
-        body_limit = max(self._penetration(pose0), 0.0) + DEPTH_TOLERANCE
+        edge0, body0 = self._edge_depth(pose0), self._penetration(pose0)
 
         def free(pose: Pose) -> bool:
-            if self._penetration(pose) > body_limit:
+            # Into the ground only where a part is not yet, or on its way out.
+            body = self._penetration(pose)
+            if body > DEPTH_TOLERANCE and body >= body0:
                 return False
-            return cutting or self._edge_depth(pose) <= edge_limit
+            if cutting:
+                return True
+            edge = self._edge_depth(pose)
+            return edge <= DEPTH_TOLERANCE or edge < edge0
 
         t, pose = 1.0, pose1
-        body_stop = self._penetration(pose1) > body_limit
+        body1 = self._penetration(pose1)
+        body_stop = body1 > DEPTH_TOLERANCE and body1 >= body0
         if body_stop or not free(pose1):
             t, pose = self._bisect(q0, target, free)
         self.cut_force = cutting_force(depth1, m.bucket_width, m) if cutting else 0.0
@@ -311,7 +318,9 @@ class ExcavatorWorldV1(ExcavatorWorld):
             self.pushed = surplus
 
     def _pour_if_tipped(self) -> None:
-        if self.fill > 0.0 and self._pose_now.n[2] < POUR_NZ:
+        """As v0, except while the edge touches the ground (the cut face holds the soil in)."""
+        pose = self._pose_now
+        if self.fill > 0.0 and pose.n[2] < POUR_NZ and self._edge_depth(pose) < -DEPTH_TOLERANCE:
             amount = min(self.fill, self.m.bucket_capacity * self.dt / POUR_TIME)
             spill0 = self.spill
             self.fill -= amount
