@@ -112,7 +112,8 @@ class Pose:
 
     def under(self) -> list[tuple[float, float, float]]:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
-        m, rot = self._world.m, self._world._rot
+        world = self._world
+        m, rot = world.m, world._rot if world.rotation is not None else None
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
         out = [
@@ -144,16 +145,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
 
     def reset(self, scene, q0) -> None:
         base = tuple(scene.base)
-        if base == (0.0, 0.0, 0.0):
-            self.rotation, self._rot = None, None
-        else:
-            r = base_rotation(*base).tolist()
-            self.rotation = r
-            self._rot = lambda v: (  # noqa: E731
-                r[0][0] * v[0] + r[0][1] * v[1] + r[0][2] * v[2],
-                r[1][0] * v[0] + r[1][1] * v[1] + r[1][2] * v[2],
-                r[2][0] * v[0] + r[2][1] * v[1] + r[2][2] * v[2],
-            )
+        self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
         self.self_clear = math.inf
         self.ground_contact = 0.0
         self.cut_force = 0.0
@@ -279,6 +271,12 @@ class ExcavatorWorldV1(ExcavatorWorld):
         return self.terrain.volume() + (self.fill + self.truck_soil) / self.m.swell
 
     # --------------------------------------------------------------- physics
+    def _rot(self, v) -> tuple[float, float, float]:
+        """``R v``: a vector of frame M in frame O (the base rotation)."""
+        (a, b, c), (d, e, f), (g, h, i) = self.rotation
+        x, y, z = v
+        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+
     def _pose(self, q) -> Pose:
         return Pose(q, self)
 
@@ -454,7 +452,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
         (x0, x1), (y0, y1), (z0, z1) = bodies.HOUSE
         x, y = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
         house = (-m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, 0.5 * (z0 + z1))
-        return (self._rot(house) if self._rot else house), self._house_radius
+        return (self._rot(house) if self.rotation else house), self._house_radius
 
 
 def _plan_gap(a, b, x: float, y: float) -> float:
