@@ -409,12 +409,18 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self.self_clear = best
 
     def _exact(self, cache: dict, name: str, other, gap, horizon: float) -> float:
-        """Distance of part ``name`` to ``other``; the bucket's sphere bound first."""
+        """Distance of part ``name`` to ``other``; for a box, its sphere's and its
+        separating axes' bounds first (the bound is returned when not under ``horizon``)."""
         if name == "bucket" or name == "house":
             c, r = self._sphere(name)
             d = (gap(c) if gap is not None else other.gap(c)) - r
             if d >= horizon:
                 return d
+            body = self._part(cache, name)
+            d = bodies.lower_bound(body, other)
+            if d >= horizon:
+                return d
+            return bodies.distance(body, other)
         return bodies.distance(self._part(cache, name), other)
 
     def _part(self, cache: dict, name: str):
