@@ -9,9 +9,9 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from motiongym.envs.sweeper import maps, task, world
+from motiongym.envs.sweeper import maps, occupancy, task
 from motiongym.envs.sweeper.measures import reward_terms, step_info
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper.occupancy import DC, DR
 
 FORWARD, LEFT, RIGHT = 0, 1, 2
 
@@ -199,7 +199,7 @@ class SweeperEnv(gym.Env):
         # Cells entering the footprint on a one-cell move, per heading: (w,) offsets.
         self._enter = []
         for k in range(4):
-            rr, cc = np.nonzero(world.entering_mask(int(DR[k]), int(DC[k]), self.w))
+            rr, cc = np.nonzero(occupancy.entering_mask(int(DR[k]), int(DC[k]), self.w))
             self._enter.append((rr, cc))
         # Leading edge of the sensing window per heading, as slices and cell indices.
         S, last = self.S, self.S - 1
@@ -327,7 +327,7 @@ class SweeperEnv(gym.Env):
             return 0, True
         new = 0
         if dr or dc:
-            rr, cc = np.nonzero(world.entering_mask(dr, dc, self.w))
+            rr, cc = np.nonzero(occupancy.entering_mask(dr, dc, self.w))
             new = self._sweep_cells(rr + nr, cc + nc)
             self.r, self.c = nr, nc
             self.path.append((nr, nc))
@@ -336,7 +336,7 @@ class SweeperEnv(gym.Env):
         h, wd = self.scenario.obstacle.shape
         self.br = min(max(self.br + int(DR[self.h]), 0), h - self.w)
         self.bc = min(max(self.bc + int(DC[self.h]), 0), wd - self.w)
-        e = np.nonzero(world.entering_mask(int(DR[self.h]), int(DC[self.h]), self.w))
+        e = np.nonzero(occupancy.entering_mask(int(DR[self.h]), int(DC[self.h]), self.w))
         self._mark_believed(e[0] + self.br, e[1] + self.bc)
         return new, False
 

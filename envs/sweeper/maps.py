@@ -23,7 +23,7 @@ import pathlib
 import numpy as np
 from scipy import ndimage
 
-from motiongym.envs.sweeper.world import is_closed
+from motiongym.envs.sweeper.occupancy import is_closed
 
 MAPS_DIR = pathlib.Path(__file__).with_name("map_files")
 SHIPPED_MAPS = ("room", "apartment", "maze")

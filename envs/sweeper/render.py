@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper.occupancy import DC, DR
 
 if TYPE_CHECKING:
     from motiongym.envs.sweeper.env import SweeperEnv

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.sweeper import generator, maps, world
+from motiongym.envs.sweeper import generator, maps, occupancy
 
 MAP_CHOICES = (*maps.SHIPPED_MAPS, "random", *(f"random-{k}" for k in generator.KINDS))
 
@@ -43,7 +43,7 @@ def resolve_map(
         return None
     else:
         raise ValueError(f"unknown map_name {map_name!r}; choices: {', '.join(MAP_CHOICES)}")
-    if not world.config_free(fixed, w).any():
+    if not occupancy.config_free(fixed, w).any():
         raise maps.MapError(f"the map has no free place for a robot of width {w}")
     return fixed
 
@@ -63,11 +63,11 @@ def sample_scenario(
     if fixed is None:
         kind = map_name.split("-", 1)[1] if "-" in map_name else None
         obstacle = generator.random_map(rng, w, kind)
-        while not world.config_free(obstacle, w).any():  # pragma: no cover - rare
+        while not occupancy.config_free(obstacle, w).any():  # pragma: no cover - rare
             obstacle = generator.random_map(rng, w, kind)
     else:
         obstacle = fixed
-    free = world.config_free(obstacle, w)
+    free = occupancy.config_free(obstacle, w)
     if options.get("start") is not None:
         start = tuple(int(v) for v in options["start"])
         if len(start) != 2:
@@ -92,6 +92,6 @@ def sample_scenario(
         heading = int(heading)
     else:
         heading = int(rng.integers(4))
-    reach_configs = world.reachable_configs(free, start)
-    reachable = world.footprint_union(reach_configs, w)
+    reach_configs = occupancy.reachable_configs(free, start)
+    reachable = occupancy.footprint_union(reach_configs, w)
     return Scenario(obstacle, free, reach_configs, reachable, start, heading)

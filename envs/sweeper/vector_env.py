@@ -13,6 +13,7 @@ from gymnasium.vector.utils import batch_space
 from motiongym.envs.sweeper import task
 from motiongym.envs.sweeper.env import SweeperEnv
 from motiongym.envs.sweeper.measures import INFO_KEYS, reward_terms, step_info
+from motiongym.envs.sweeper.occupancy import DC, DR
 from motiongym.envs.sweeper.vector_state import (
     COUNT,
     KNOWN,
@@ -21,7 +22,6 @@ from motiongym.envs.sweeper.vector_state import (
     check_actions,
     spread_info,
 )
-from motiongym.envs.sweeper.world import DC, DR
 
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
 

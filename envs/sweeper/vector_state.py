@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from motiongym.envs.sweeper import world
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper import occupancy
+from motiongym.envs.sweeper.occupancy import DC, DR
 
 COUNT = np.uint8(3)  # bits of a cell's state holding its sweep count (0, 1, 2 = twice or more)
 KNOWN = np.uint8(4)  # bit of a cell's state: an obstacle the robot has sensed
@@ -105,7 +105,7 @@ class BatchedGrids:
         self.foot_off = ((fy + P) * Wp + fx + P).astype(np.int64)  # (w*w,) footprint
         enter, self.enter_win = [], []
         for k in range(4):  # cells entering the footprint on a move along heading k
-            rr, cc = np.nonzero(world.entering_mask(int(DR[k]), int(DC[k]), w))
+            rr, cc = np.nonzero(occupancy.entering_mask(int(DR[k]), int(DC[k]), w))
             enter.append((rr + P) * Wp + cc + P)  # relative to the new anchor
             self.enter_win.append((rr + P, cc + P))  # where they sit in the (S, S) window
         self.enter_off = np.array(enter, np.int64)  # (4, w)

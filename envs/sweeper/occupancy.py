@@ -1,4 +1,4 @@
-"""The sweeper's grid world: pure functions over NumPy arrays.
+"""The sweeper's occupancy grid: pure functions over NumPy arrays (no state).
 
 The world is an occupancy bitmap ``obstacle`` of shape ``(H, W)`` (True: wall
 or obstacle). The robot is a square of side ``w`` cells; its *configuration*
