@@ -9,7 +9,8 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from motiongym.envs.sweeper import maps, occupancy, task
+from motiongym.envs.core import check_bool
+from motiongym.envs.sweeper import maps, occupancy, sight, task
 from motiongym.envs.sweeper.measures import reward_terms, step_info
 from motiongym.envs.sweeper.occupancy import DC, DR
 
@@ -25,6 +26,13 @@ class SweeperEnv(gym.Env):
     unless fixed by ``reset(options=...)``, and knows nothing of the map: it
     senses obstacles within ``sensor_range`` cells of its footprint and feels
     bumps. Distances are in cells (the paper's "base units").
+
+    ``motiongym/Sweeper-v1`` (``line_of_sight=True``) senses through lines of
+    sight: a window cell is sensed when the Bresenham line from some footprint
+    cell to it crosses no obstacle cell before it (the obstacle itself is
+    sensed, what lies behind it is not; cells outside the map are obstacles);
+    see :mod:`motiongym.envs.sweeper.sight`. ``motiongym/Sweeper-v0`` is the
+    see-through variant: every obstacle in the window is sensed.
 
     ## Action space: ``Discrete(3)``
     ===== ==========================================================
@@ -58,6 +66,10 @@ class SweeperEnv(gym.Env):
                            covers a ``ceil(H/K) x ceil(W/K)`` block of the
                            map and holds the fraction swept
     obstacle_map  (K*K,)   same blocks: fraction of known obstacle cells
+    known         (S*S,)   v1 only: 1.0 for a window cell sensed on this step
+                           (visible from the footprint), 0.0 for unknown;
+                           same layout as ``sensed``, which in v1 is 1.0
+                           only for a sensed obstacle (0.0: free or unknown)
     ============= ======== ===================================================
 
     Everything is float32 in [0, 1] except ``pose`` (rows/columns up to 256).
@@ -116,10 +128,14 @@ class SweeperEnv(gym.Env):
     ``robot_width`` (cells, 3), ``sensor_range`` (cells beyond the footprint,
     default ``robot_width``), ``coarse`` (K, 16), ``heading_noise``,
     ``slip_noise``, ``sweep_reward``, ``time_reward``, ``bump_reward``,
-    ``render_mode`` ("rgb_array"), ``cell_pixels`` (render scale).
+    ``render_mode`` ("rgb_array"), ``cell_pixels`` (render scale),
+    ``line_of_sight`` (False; True in v1).
 
     ## Version history
-    - v0: first version.
+    - v1: line-of-sight sensing (an obstacle hides what lies behind it) and
+      the ``known`` observation key telling unknown from free.
+    - v0: first version; the window sees through walls (kept as the
+      see-through variant).
     """
 
     metadata = {
@@ -153,6 +169,7 @@ class SweeperEnv(gym.Env):
         bump_reward: float = -1.0,
         render_mode: str | None = None,
         cell_pixels: int = 8,
+        line_of_sight: bool = False,
     ) -> None:
         if int(robot_width) != robot_width or robot_width < 1:
             raise ValueError(f"robot_width must be a positive integer, got {robot_width!r}")
@@ -181,20 +198,23 @@ class SweeperEnv(gym.Env):
         self.cell_pixels = int(cell_pixels)
 
         self.S = self.w + 2 * self.R
+        self.line_of_sight = check_bool("line_of_sight", line_of_sight)
+        self._rays = sight.ray_matrix(self.w, self.R) if self.line_of_sight else None
         side = float(maps.MAX_SIDE)
         window = spaces.Box(0.0, 1.0, (self.S * self.S,), np.float32)
         coarse_map = spaces.Box(0.0, 1.0, (self.K * self.K,), np.float32)
-        self.observation_space = spaces.Dict(
-            {
-                "sensed": window,
-                "swept": window,
-                "pose": spaces.Box(
-                    np.zeros(4, np.float32), np.array([side, side, 3.0, 1.0], np.float32)
-                ),
-                "sweep_map": coarse_map,
-                "obstacle_map": coarse_map,
-            }
-        )
+        keys = {
+            "sensed": window,
+            "swept": window,
+            "pose": spaces.Box(
+                np.zeros(4, np.float32), np.array([side, side, 3.0, 1.0], np.float32)
+            ),
+            "sweep_map": coarse_map,
+            "obstacle_map": coarse_map,
+        }
+        if self.line_of_sight:
+            keys["known"] = window
+        self.observation_space = spaces.Dict(keys)
         self.action_space = spaces.Discrete(3)
         # Cells entering the footprint on a one-cell move, per heading: (w,) offsets.
         self._enter = []
@@ -370,6 +390,12 @@ class SweeperEnv(gym.Env):
         r0, c0 = self.r + P - R, self.c + P - R
         self.win = self.obst_pad[r0 : r0 + S, c0 : c0 + S]
         win = self.obst_bool[r0 : r0 + S, c0 : c0 + S]
+        if self.line_of_sight:  # v1: only what a line from the footprint reaches
+            vis = sight.visible(win.ravel(), self._rays).reshape(S, S)
+            self.vis = vis.astype(np.float32)
+            win = win & vis
+            self.win = win.astype(np.float32)
+            heading = None
         known = self.kobst[self.br : self.br + S, self.bc : self.bc + S]
         if heading is not None:
             edge = self._edges[heading]
@@ -399,13 +425,16 @@ class SweeperEnv(gym.Env):
 
     def _obs(self, bump: bool) -> dict:
         S = self.S
-        return {
+        obs = {
             "sensed": self.win.flatten(),
             "swept": self.bswept[self.br : self.br + S, self.bc : self.bc + S].flatten(),
             "pose": np.array([self.br, self.bc, self.h, float(bump)], np.float32),
             "sweep_map": (self.coarse_swept * self.inv_block).ravel(),
             "obstacle_map": (self.coarse_obst * self.inv_block).ravel(),
         }
+        if self.line_of_sight:
+            obs["known"] = self.vis.flatten()
+        return obs
 
     def _info(self, rewards: tuple[float, float, float], bump: bool) -> dict:
         return step_info(

@@ -10,7 +10,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from motiongym.envs.sweeper import task
+from motiongym.envs.sweeper import sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
 from motiongym.envs.sweeper.measures import INFO_KEYS, reward_terms, step_info
 from motiongym.envs.sweeper.occupancy import DC, DR
@@ -23,6 +23,7 @@ from motiongym.envs.sweeper.vector_state import (
     spread_info,
 )
 
+WINDOW_KEYS = ("sensed", "swept", "known")  # the planes of the kept windows, in order
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
 
 
@@ -128,7 +129,9 @@ class SweeperVectorEnv(VectorEnv):
         self.sw_obs = np.zeros((N, KK), np.float32)  # csw * inv_block, kept current
         self.ob_obs = np.zeros((N, KK), np.float32)  # cob * inv_block, kept current
         S = self.S
-        self.win = np.zeros((N, 2, S, S), np.uint8)  # windows [sensed, swept] (0/1), kept current
+        self._rays = single._rays  # v1's lines of sight (None: v0, the see-through window)
+        planes = 2 if self._rays is None else 3
+        self.win = np.zeros((N, planes, S, S), np.uint8)  # [sensed, swept, known (v1)], current
         self._rngs: list[np.random.Generator | None] = [None] * N
         self._scenarios: list[task.Scenario | None] = [None] * N
         self._paths: list[list[tuple[int, int]]] = [[] for _ in range(N)]
@@ -204,6 +207,10 @@ class SweeperVectorEnv(VectorEnv):
             self.csw[i] = 0.0
             np.add.at(self.csw[i], g.block[m, foot], one)
             obst = g.obst[m, win]
+            if self._rays is not None:
+                vis = sight.visible(obst, self._rays)
+                obst = obst & vis
+                self.win[i, 2] = vis.reshape(S, S)
             g.cell[i, win[obst]] |= KNOWN
             seen = g.block[m, win[obst]]
             self.cob[i] = 0.0
@@ -283,7 +290,52 @@ class SweeperVectorEnv(VectorEnv):
             target = env * KK + g.block.ravel()[at_map[ri, 0] + enter[ri, ci]]
             self._count(self.csw, self.sw_obs, env, target)
             changes["sweep"].append(target)
-        # Sense the window's leading edge (the only cells new to it).
+        if self._rays is not None:
+            self._sense_window(moved, at_map[:, 0], at_cell[:, 0], changes)
+        else:
+            self._sense_edge(moved, hm, at_map, at_cell, changes)
+        changes["rows"].append(moved)
+        if self.render_mode is not None:
+            rows, cols = self.r[moved].tolist(), self.c[moved].tolist()
+            for i, r, c in zip(moved.tolist(), rows, cols, strict=True):
+                self._paths[i].append((r, c))
+        return moved, new
+
+    def _sense_window(
+        self, moved: np.ndarray, at_map: np.ndarray, at_cell: np.ndarray, changes: dict
+    ) -> None:
+        """v1: sense the whole window of the worlds ``moved`` through lines of sight."""
+        g, KK, S = self._grids, self.K * self.K, self.S
+        cell = g.cell.ravel()
+        obst = g.obst.ravel()[at_map[:, None] + g.win_off]  # (M, S*S)
+        vis = sight.visible(obst, self._rays)
+        obst &= vis
+        where = at_cell[:, None] + g.win_off
+        state = cell[where]
+        seen = obst & (state < KNOWN)
+        if seen.any():
+            ri, ci = np.nonzero(seen)
+            cell[where[ri, ci]] = state[ri, ci] | KNOWN
+            blocks = g.block.ravel()[at_map[ri] + g.win_off[ci]]
+            inside = blocks >= 0
+            env = moved[ri[inside]]
+            target = env * KK + blocks[inside]
+            self._count(self.cob, self.ob_obs, env, target)
+            changes["obst"].append(target)
+        M = len(moved)
+        self.win[moved] = np.stack([obst, (state & COUNT) != 0, vis], axis=1).reshape(M, 3, S, S)
+
+    def _sense_edge(
+        self,
+        moved: np.ndarray,
+        hm: np.ndarray,
+        at_map: np.ndarray,
+        at_cell: np.ndarray,
+        changes: dict,
+    ) -> None:
+        """v0: sense the window's leading edge (the only cells new to it); shift the windows."""
+        g, KK = self._grids, self.K * self.K
+        cell = g.cell.ravel()
         edge = g.edge_off[hm]  # (M, S)
         obst = g.obst.ravel()[at_map + edge]
         state = cell[at_cell + edge]
@@ -324,12 +376,6 @@ class SweeperVectorEnv(VectorEnv):
             rr, cc = g.enter_win[k]
             part[:, 1, rr, cc] = 1
         self.win[moved] = win
-        changes["rows"].append(moved)
-        if self.render_mode is not None:
-            rows, cols = self.r[moved].tolist(), self.c[moved].tolist()
-            for i, r, c in zip(moved.tolist(), rows, cols, strict=True):
-                self._paths[i].append((r, c))
-        return moved, new
 
     def _count(
         self, counts: np.ndarray, scaled: np.ndarray, env: np.ndarray, target: np.ndarray
@@ -368,27 +414,27 @@ class SweeperVectorEnv(VectorEnv):
         N, SS = self.num_envs, self.S * self.S
         if idx is not None:
             pose = np.stack([self.r[idx], self.c[idx], self.h[idx], self.bump[idx]], axis=1)
-            return {
-                "sensed": self.win[idx, 0].reshape(-1, SS).astype(np.float32),
-                "swept": self.win[idx, 1].reshape(-1, SS).astype(np.float32),
-                "pose": pose.astype(np.float32),
-                "sweep_map": self.sw_obs[idx],
-                "obstacle_map": self.ob_obs[idx],
+            obs = {
+                key: self.win[idx, k].reshape(-1, SS).astype(np.float32)
+                for k, key in enumerate(WINDOW_KEYS[: self.win.shape[1]])
             }
+            obs.update(pose=pose.astype(np.float32), sweep_map=self.sw_obs[idx])
+            obs["obstacle_map"] = self.ob_obs[idx]
+            return obs
         out, missing = self._pool.take()
         pose = out["pose"]
         pose[:, 0], pose[:, 1], pose[:, 2], pose[:, 3] = self.r, self.c, self.h, self.bump
         if missing is None:  # copy whole
-            np.copyto(out["sensed"], self.win[:, 0].reshape(N, SS))
-            np.copyto(out["swept"], self.win[:, 1].reshape(N, SS))
+            for k, key in enumerate(WINDOW_KEYS[: self.win.shape[1]]):
+                np.copyto(out[key], self.win[:, k].reshape(N, SS))
             np.copyto(out["sweep_map"], self.sw_obs)
             np.copyto(out["obstacle_map"], self.ob_obs)
             return dict(out)
         parts = {key: [a for c in missing for a in c[key]] for key in missing[0]} if missing else {}
         if parts.get("rows") or parts.get("reset"):
             rows = np.concatenate(parts["rows"] + parts["reset"])
-            out["sensed"][rows] = self.win[rows, 0].reshape(-1, SS)
-            out["swept"][rows] = self.win[rows, 1].reshape(-1, SS)
+            for k, key in enumerate(WINDOW_KEYS[: self.win.shape[1]]):
+                out[key][rows] = self.win[rows, k].reshape(-1, SS)
         for key, src in (("sweep", self.sw_obs), ("obst", self.ob_obs)):
             dst = out["sweep_map" if key == "sweep" else "obstacle_map"]
             if parts.get(key):

@@ -74,6 +74,11 @@ def compare(num_envs: int, max_steps: int, n_steps: int, seed: int, **kwargs) ->
         ),
         ({"map_name": "random-room"}, 5, 60, 300),  # maps of several shapes: the layout grows
         ({"map_name": "random"}, 3, 50, 300),
+        # v1 (line of sight): the whole window is sensed again after every move
+        ({"grid": empty_room(8, 11), "line_of_sight": True}, 4, 150, 800),
+        ({"map_name": "room", "line_of_sight": True}, 3, 70, 600),
+        ({"map_name": "maze", "robot_width": 2, "coarse": 8, "line_of_sight": True}, 2, 90, 400),
+        ({"map_name": "random", "sensor_range": 5, "line_of_sight": True}, 3, 50, 300),
     ],
 )
 def test_step_for_step_equal_to_sync_vector_env(kwargs, num_envs, max_steps, n_steps) -> None:
@@ -302,6 +307,8 @@ def test_make_vec_vector_entry_point() -> None:
         ({"map_name": "random-maze", "robot_width": 2}, 6, 200),
         ({"map_name": "random-apartment", "robot_width": 5, "sensor_range": 2}, 6, 200),
         ({"map_name": "random", "time_reward": -0.3, "bump_reward": -2.5}, 8, 150),
+        ({"map_name": "apartment", "robot_width": 1, "line_of_sight": True}, 4, 400),
+        ({"map_name": "random-apartment", "sensor_range": 6, "line_of_sight": True}, 6, 200),
     ],
 )
 def test_long_runs_equal_to_sync_vector_env(kwargs, num_envs, max_steps) -> None:
