@@ -238,7 +238,7 @@ def walls_turned_study(quick: bool) -> dict:
                 "travel_ratio": r["travel_ratio"],
                 "coverage": r["coverage"],
                 "left_to_cwa": 1.0 - r["psa_coverage"],
-                "reachable": int(env.unwrapped.n_reach),
+                "reachable": env.unwrapped.state.n_reachable,
             }
         )
     return {

@@ -25,6 +25,7 @@ from motiongym.baselines.sweeper import cwa, psa, quadtree
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.params import SweeperParams
 
 FORWARD, LEFT, RIGHT = 0, 1, 2
 
@@ -36,7 +37,7 @@ def turn_towards(heading: int, target: int) -> int:
 
 def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:
     """``(w, R)``: the robot width (from the env's keywords) and sensing range (window size)."""
-    w = int(env_kwargs.get("robot_width", 3))
+    w = SweeperParams.from_kwargs(env_kwargs).robot_width
     s = int(round(np.sqrt(observation_space["sensed"].shape[0])))
     return w, (s - w) // 2
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -10,10 +9,13 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
+from motiongym.envs.core import check_options, zero_terms
 from motiongym.envs.sweeper import sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
-from motiongym.envs.sweeper.measures import INFO_KEYS, reward_terms, step_info
+from motiongym.envs.sweeper.measures import INFO_KEYS, batch_info, measures
 from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.render import draw
+from motiongym.envs.sweeper.state import SweeperState
 from motiongym.envs.sweeper.vector_state import (
     COUNT,
     KNOWN,
@@ -96,14 +98,15 @@ class SweeperVectorEnv(VectorEnv):
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
         if max_episode_steps is None or int(max_episode_steps) < 1:
             raise ValueError(f"max_episode_steps must be >= 1, got {max_episode_steps!r}")
-        for name in ("heading_noise", "slip_noise"):
-            if kwargs.get(name, 0.0):
-                raise ValueError(
-                    f"{name}={kwargs[name]!r}: odometry noise is not batched in "
-                    "SweeperVectorEnv; use SyncVectorEnv of SweeperEnv for noisy runs"
-                )
         # The single environment validates the keywords and holds the spaces.
         self._single = single = SweeperEnv(render_mode=render_mode, **kwargs)
+        self.params = p = single.params
+        for name in ("heading_noise", "slip_noise"):
+            if getattr(p, name):
+                raise ValueError(
+                    f"{name}={getattr(p, name)!r}: odometry noise is not batched in "
+                    "SweeperVectorEnv; use SyncVectorEnv of SweeperEnv for noisy runs"
+                )
         self.num_envs = N = int(num_envs)
         self.max_episode_steps = int(max_episode_steps)
         self.render_mode = render_mode
@@ -111,7 +114,7 @@ class SweeperVectorEnv(VectorEnv):
         self.observation_space = batch_space(single.observation_space, N)
         self.single_action_space = single.action_space
         self.action_space = batch_space(single.action_space, N)
-        self.w, self.R, self.S, self.K = single.w, single.R, single.S, single.K
+        self.w, self.R, self.S, self.K = p.robot_width, p.sensor_range, p.window, p.coarse
         self._grids = BatchedGrids(N, self.w, self.R, self.K, single.fixed)
 
         i64 = np.int64
@@ -129,7 +132,8 @@ class SweeperVectorEnv(VectorEnv):
         self.sw_obs = np.zeros((N, KK), np.float32)  # csw * inv_block, kept current
         self.ob_obs = np.zeros((N, KK), np.float32)  # cob * inv_block, kept current
         S = self.S
-        self._rays = single._rays  # v1's lines of sight (None: v0, the see-through window)
+        # v1's lines of sight (None: v0, the see-through window)
+        self._rays = sight.ray_matrix(self.w, self.R) if p.line_of_sight else None
         planes = 2 if self._rays is None else 3
         self.win = np.zeros((N, planes, S, S), np.uint8)  # [sensed, swept, known (v1)], current
         self._rngs: list[np.random.Generator | None] = [None] * N
@@ -151,7 +155,7 @@ class SweeperVectorEnv(VectorEnv):
             seeds = list(seed)
             if len(seeds) != N:
                 raise ValueError(f"reset got {len(seeds)} seeds for num_envs={N}")
-        options = dict(options or {})
+        options = check_options(options, {**task.OPTIONS, "reset_mask": lambda _, mask: mask})
         mask = options.pop("reset_mask", None)
         if mask is None:
             idx = np.arange(N)
@@ -166,8 +170,7 @@ class SweeperVectorEnv(VectorEnv):
             idx = np.flatnonzero(mask)
         self._reset_envs(idx, [seeds[i] for i in idx], options or None)
         self._ready = True
-        zeros = np.zeros(len(idx))
-        info = self._info(idx, (zeros, 0.0, zeros), np.zeros(len(idx), bool))
+        info = self._info(idx, zero_terms(task.REWARD_TERMS), np.zeros(len(idx), bool))
         if mask is not None:
             info = spread_info(info, idx, N)
         self._pool.record(None)
@@ -180,7 +183,9 @@ class SweeperVectorEnv(VectorEnv):
         for i, s in zip(idx.tolist(), seeds, strict=True):
             if s is not None or self._rngs[i] is None:
                 self._rngs[i] = seeding.np_random(s)[0]
-            sc = task.sample_scenario(self._rngs[i], single.fixed, single.map_name, self.w, options)
+            sc = task.sample_scenario(
+                self._rngs[i], single.fixed, self.params.map_name, self.w, options
+            )
             scenarios.append(sc)
         shape = np.array([sc.obstacle.shape for sc in scenarios]).max(axis=0)
         if g.ensure(int(shape[0]), int(shape[1])):
@@ -242,14 +247,11 @@ class SweeperVectorEnv(VectorEnv):
         if ok.any():
             moved, count = self._move(fwd[ok], hf[ok], na[ok], changes)
             new[moved] = count
-        single = self._single
-        rewards = reward_terms(
-            new, bump, self.w, single.sweep_reward, single.time_reward, single.bump_reward
-        )
-        reward = rewards[0] + rewards[1] + rewards[2]
-        terminated = self.n_swept >= self.n_reach
+        terms = task.reward_terms(new, bump, self.params)
+        reward = terms["sweep"] + terms["time"] + terms["bump"]
+        terminated = task.is_success(self.n_swept, self.n_reach)
         truncated = self.steps >= self.max_episode_steps
-        info = self._info(slice(None), rewards, bump)
+        info = self._info(slice(None), terms, bump)
         self._pool.record(changes)
         obs = self._observation()
         done = terminated | truncated
@@ -399,8 +401,7 @@ class SweeperVectorEnv(VectorEnv):
             final_info[key], final_info[f"_{key}"] = arr, done.copy()
         self._reset_envs(di, [None] * len(di), None)
         changes["reset"].append(di)
-        zeros = np.zeros(len(di))
-        fresh = self._info(di, (zeros, 0.0, zeros), np.zeros(len(di), bool))
+        fresh = self._info(di, zero_terms(task.REWARD_TERMS), np.zeros(len(di), bool))
         for key in INFO_KEYS:
             info[key][di] = fresh[key]
         for key, value in self._observation(di).items():
@@ -445,18 +446,22 @@ class SweeperVectorEnv(VectorEnv):
                 dst[rows] = src[rows]
         return dict(out)
 
-    def _info(self, idx: Any, rewards: tuple[Any, float, Any], bump: np.ndarray) -> dict:
-        info = step_info(
-            self.n_swept[idx],
-            self.n_reach[idx],
-            self.n_over[idx],
-            self.travel[idx],
-            self.turns[idx],
-            self.bumps[idx],
-            self.steps[idx],
-            self.w,
+    def _info(self, idx: Any, terms: dict[str, Any], bump: np.ndarray) -> dict:
+        n_swept, n_reach = self.n_swept[idx], self.n_reach[idx]
+        info = batch_info(
+            task.is_success(n_swept, n_reach),
             bump,
-            rewards,
+            terms,
+            **measures(
+                n_swept,
+                n_reach,
+                self.n_over[idx],
+                self.travel[idx],
+                self.turns[idx],
+                self.bumps[idx],
+                self.steps[idx],
+                self.w,
+            ),
         )
         mask = np.ones(len(info["coverage"]), bool)
         for key in INFO_KEYS:
@@ -464,27 +469,51 @@ class SweeperVectorEnv(VectorEnv):
         return info
 
     # ----------------------------------------------------------------- render
+    def state(self, i: int) -> SweeperState:
+        """Sub-environment ``i``'s state, as the single environment holds it.
+
+        Without odometry noise the believed pose is the true one; sweep counts
+        stop at 2 (the twin stores no more); ``path`` is recorded only when
+        ``render_mode="rgb_array"``.
+        """
+        if not self._ready:
+            raise RuntimeError("call reset() before state()")
+        g, P = self._grids, self.R
+        sc = self._scenarios[i]
+        H, W = sc.obstacle.shape
+        cell = g.cell[i].reshape(g.Hp, g.Wp)[: H + 2 * P, : W + 2 * P]
+        r, c = int(self.r[i]), int(self.c[i])
+        K = self.K
+        return SweeperState(
+            scenario=sc,
+            row=r,
+            col=c,
+            heading=int(self.h[i]),
+            believed_row=r,
+            believed_col=c,
+            y=float(r),
+            x=float(c),
+            heading_error=0.0,
+            sweeps=(cell[P : P + H, P : P + W] & COUNT).astype(np.int32),
+            believed_swept=((cell & COUNT) > 0).astype(np.float32),
+            known_obstacles=(cell & KNOWN) > 0,
+            coarse_swept=self.csw[i].reshape(K, K).copy(),
+            coarse_obstacles=self.cob[i].reshape(K, K).copy(),
+            window=self.win[i, 0].astype(np.float32),
+            visible=None if self._rays is None else self.win[i, 2].astype(np.float32),
+            n_reachable=int(self.n_reach[i]),
+            n_swept=int(self.n_swept[i]),
+            n_overswept=int(self.n_over[i]),
+            turns=int(self.turns[i]),
+            bumps=int(self.bumps[i]),
+            steps=int(self.steps[i]),
+            travel=float(self.travel[i]),
+            bump=bool(self.bump[i]),
+            path=list(self._paths[i]),
+        )
+
     def render(self) -> tuple[np.ndarray, ...] | None:
         if self.render_mode != "rgb_array" or not self._ready:
             return None
-        from motiongym.envs.sweeper.render import draw
-
-        g, P, frames = self._grids, self.R, []
-        for i in range(self.num_envs):
-            H, W = self._scenarios[i].obstacle.shape
-            cnt = (g.cell[i] & COUNT).reshape(g.Hp, g.Wp)[P : P + H, P : P + W]
-            r, c = int(self.r[i]), int(self.c[i])
-            view = SimpleNamespace(
-                scenario=self._scenarios[i],
-                sweeps=cnt,
-                path=self._paths[i],
-                noisy=False,
-                w=self.w,
-                r=r,
-                c=c,
-                br=r,
-                bc=c,
-                h=int(self.h[i]),
-            )
-            frames.append(draw(view, self._single.cell_pixels))
-        return tuple(frames)
+        px = self.params.cell_pixels
+        return tuple(draw(self.state(i), self.w, px) for i in range(self.num_envs))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -122,7 +124,7 @@ def test_map_errors(tmp_path) -> None:
     with pytest.raises(maps.MapError, match="no free cell"):
         maps.load_map_file(tmp_path / "full.txt")
     (tmp_path / "bad.txt").write_text("###\n#x#\n###\n")
-    with pytest.raises(maps.MapError, match="characters"):
+    with pytest.raises(maps.MapError, match="line 2, column 2: character 'x'"):
         maps.load_map_file(tmp_path / "bad.txt")
     (tmp_path / "m.bmp").write_text("")
     with pytest.raises(maps.MapError, match="unknown format"):
@@ -167,3 +169,45 @@ def test_smartdfs_bound_blocks_anchored_at_the_start() -> None:
     assert occupancy.smartdfs_bound(reach, 3, (3, 6)) == occupancy.smartdfs_bound(reach, 3)
     bound = occupancy.smartdfs_bound(reach, 3, (1, 1))  # blocks straddle the floor's edges
     assert (bound.cells, bound.edges) == (35, 24)
+
+
+@pytest.mark.parametrize(
+    ("text", "w", "message"),
+    [
+        ("#####\n#...#\n#.o.#\n#####\n", 1, "line 3, column 3: character 'o'"),
+        ("#####\n#...#\n#..\t#\n#####\n", 1, "line 3, column 4: character '\\t'"),
+        ("#####\n#...#\n#..#\n#####\n", 1, "line 3, column 5: ragged rows, this line has 4"),
+        ("#####\n#...##\n#####\n", 1, "line 2, column 6: ragged rows, this line has 6"),
+        ("#####\n#...#\n\n#####\n", 1, "line 3, column 1: ragged rows"),
+        ("\n#####\n#...#\n#####\n", 1, "line 2, column 1: ragged rows"),
+        ("#####\n#....\n#####\n", 1, "not closed: line 2, column 5 is a free cell on the border"),
+        ("#.###\n#...#\n#####\n", 1, "not closed: line 1, column 2"),
+        (
+            "######\n#..#.#\n#..###\n######\n",
+            3,
+            "no free place for a robot of width 3: the widest free square is 2 x 2 cells, "
+            "at line 2, column 2",
+        ),
+        ("#####\n#####\n", 1, "has no free cell"),
+    ],
+)
+def test_bad_map_files_get_one_line_naming_line_and_column(tmp_path, text, w, message) -> None:
+    path = tmp_path / "m.txt"
+    path.write_text(text)
+    with pytest.raises(maps.MapError, match=re.escape(message)) as caught:
+        maps.load_map_file(path, w)
+    assert "\n" not in str(caught.value)
+    assert str(path) in str(caught.value)
+
+
+def test_blank_lines_after_a_map_are_ignored_and_the_env_checks_the_robot_width(tmp_path) -> None:
+    path = tmp_path / "m.txt"
+    path.write_text("#####\n#...#\n#...#\n#...#\n#####\n\n\n")
+    assert maps.load_map_file(path).shape == (5, 5)
+    from motiongym.envs.sweeper.env import SweeperEnv
+
+    SweeperEnv(map_file=str(path), robot_width=3).reset(seed=0)
+    with pytest.raises(
+        maps.MapError, match="widest free square is 3 x 3 cells, at line 2, column 2"
+    ):
+        SweeperEnv(map_file=str(path), robot_width=4)
