@@ -226,8 +226,7 @@ class SweeperEnv(NeedsReset, gym.Env):
         new = self.world.advance(action, self.np_random)
         s = self.world.state
         reward, info = self._reward_and_info(task.reward_terms(new, s.bump, self.params))
-        terminated = bool(task.is_success(s.n_swept, s.n_reachable))
-        return self.world.observation(), reward, terminated, False, info
+        return self.world.observation(), reward, info["is_success"], False, info
 
     def _checked_action(self, action: Any) -> int:
         if not self.action_space.contains(action):

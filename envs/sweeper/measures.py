@@ -35,7 +35,7 @@ def measures(
     Counters are scalars for one world or arrays for a batch; batched values
     are copied, so later steps never change a returned ``info``.
     """
-    own = np.array if np.ndim(n_swept) > 0 else (lambda value: value)
+    own = np.array if isinstance(n_swept, np.ndarray) else (lambda value: value)
     return {
         "coverage": n_swept / n_reach,
         "travel": own(travel),

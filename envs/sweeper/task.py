@@ -115,7 +115,8 @@ def reward_terms(new_cells: Any, bump: Any, params: SweeperParams) -> dict[str, 
     - ``bump``: ``params.bump`` on a bump.
     """
     weight = params.bump
-    bumped = np.where(bump, weight, 0.0) if np.ndim(bump) else (weight if bump else 0.0)
+    batched = isinstance(bump, np.ndarray)
+    bumped = np.where(bump, weight, 0.0) if batched else (weight if bump else 0.0)
     return {
         "sweep": params.sweep * new_cells / params.robot_width,
         "time": params.time,

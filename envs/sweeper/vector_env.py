@@ -22,6 +22,7 @@ from motiongym.envs.sweeper.vector_state import (
     BatchedGrids,
     ObservationPool,
     check_actions,
+    shift_windows,
     spread_info,
 )
 
@@ -307,77 +308,51 @@ class SweeperVectorEnv(VectorEnv):
         self, moved: np.ndarray, at_map: np.ndarray, at_cell: np.ndarray, changes: dict
     ) -> None:
         """v1: sense the whole window of the worlds ``moved`` through lines of sight."""
-        g, KK, S = self._grids, self.K * self.K, self.S
-        cell = g.cell.ravel()
+        g, S = self._grids, self.S
         obst = g.obst.ravel()[at_map[:, None] + g.win_off]  # (M, S*S)
         vis = sight.visible(obst, self._rays)
         obst &= vis
         where = at_cell[:, None] + g.win_off
-        state = cell[where]
+        state = g.cell.ravel()[where]
         seen = obst & (state < KNOWN)
         if seen.any():
             ri, ci = np.nonzero(seen)
-            cell[where[ri, ci]] = state[ri, ci] | KNOWN
-            blocks = g.block.ravel()[at_map[ri] + g.win_off[ci]]
-            inside = blocks >= 0
-            env = moved[ri[inside]]
-            target = env * KK + blocks[inside]
-            self._count(self.cob, self.ob_obs, env, target)
-            changes["obst"].append(target)
+            cells, maps = where[ri, ci], at_map[ri] + g.win_off[ci]
+            self._file_obstacles(moved[ri], cells, maps, state[ri, ci], changes)
         M = len(moved)
         self.win[moved] = np.stack([obst, (state & COUNT) != 0, vis], axis=1).reshape(M, 3, S, S)
 
     def _sense_edge(
-        self,
-        moved: np.ndarray,
-        hm: np.ndarray,
-        at_map: np.ndarray,
-        at_cell: np.ndarray,
-        changes: dict,
+        self, moved: np.ndarray, hm: np.ndarray, at_map: np.ndarray, at_cell: np.ndarray, changes
     ) -> None:
         """v0: sense the window's leading edge (the only cells new to it); shift the windows."""
-        g, KK = self._grids, self.K * self.K
-        cell = g.cell.ravel()
+        g = self._grids
         edge = g.edge_off[hm]  # (M, S)
         obst = g.obst.ravel()[at_map + edge]
-        state = cell[at_cell + edge]
+        state = g.cell.ravel()[at_cell + edge]
         seen = obst & (state < KNOWN)
         if seen.any():
             ri, ci = np.nonzero(seen)
             e = edge[ri, ci]
-            cell[at_cell[ri, 0] + e] = state[ri, ci] | KNOWN
-            blocks = g.block.ravel()[at_map[ri, 0] + e]
-            inside = blocks >= 0
-            env = moved[ri[inside]]
-            target = env * KK + blocks[inside]
-            self._count(self.cob, self.ob_obs, env, target)
-            changes["obst"].append(target)
-        # Observation windows: shift by the move, fill the leading edge and the
-        # entering (now swept) cells; nothing else in a window changes.
+            self._file_obstacles(
+                moved[ri], at_cell[ri, 0] + e, at_map[ri, 0] + e, state[ri, ci], changes
+            )
         fill = np.stack([obst, (state & COUNT) != 0], axis=1)  # (M, 2, S)
-        old = self.win[moved]  # (M, 2, S, S)
-        win = np.empty_like(old)
-        bounds = np.searchsorted(hm, np.arange(5))
-        for k in range(4):
-            lo, hi = bounds[k], bounds[k + 1]
-            if lo == hi:
-                continue
-            part, was, f = win[lo:hi], old[lo:hi], fill[lo:hi]
-            if k == 0:  # east: new[i, j] = old[i, j + 1]
-                part[..., :-1] = was[..., 1:]
-                part[..., -1] = f
-            elif k == 1:  # north: new[i, j] = old[i - 1, j]
-                part[..., 1:, :] = was[..., :-1, :]
-                part[..., 0, :] = f
-            elif k == 2:  # west: new[i, j] = old[i, j - 1]
-                part[..., 1:] = was[..., :-1]
-                part[..., 0] = f
-            else:  # south: new[i, j] = old[i + 1, j]
-                part[..., :-1, :] = was[..., 1:, :]
-                part[..., -1, :] = f
-            rr, cc = g.enter_win[k]
-            part[:, 1, rr, cc] = 1
-        self.win[moved] = win
+        self.win[moved] = shift_windows(self.win[moved], fill, hm, g.enter_win)
+
+    def _file_obstacles(
+        self, env: np.ndarray, cells: np.ndarray, maps: np.ndarray, state: np.ndarray, changes
+    ) -> None:
+        """Mark sensed obstacles known: flat ``cells`` of ``g.cell`` (previous ``state``),
+        flat ``maps`` of ``g.block``, of worlds ``env``; count them in the coarse maps."""
+        g = self._grids
+        g.cell.ravel()[cells] = state | KNOWN
+        blocks = g.block.ravel()[maps]
+        inside = blocks >= 0
+        env = env[inside]
+        target = env * (self.K * self.K) + blocks[inside]
+        self._count(self.cob, self.ob_obs, env, target)
+        changes["obst"].append(target)
 
     def _count(
         self, counts: np.ndarray, scaled: np.ndarray, env: np.ndarray, target: np.ndarray

@@ -200,6 +200,40 @@ def check_actions(actions: Any, N: int) -> np.ndarray:
     return a
 
 
+def shift_windows(
+    old: np.ndarray, fill: np.ndarray, heading: np.ndarray, enter_win: list
+) -> np.ndarray:
+    """v0's windows after a one-cell move: ``(M, 2, S, S)`` [sensed, swept].
+
+    ``old`` windows shift by the move along ``heading`` (sorted, ``(M,)``),
+    the leading edge takes ``fill`` ``(M, 2, S)`` and the cells entering the
+    footprint (``enter_win[k]``, window indices) become swept; nothing else
+    in a window changes.
+    """
+    win = np.empty_like(old)
+    bounds = np.searchsorted(heading, np.arange(5))
+    for k in range(4):
+        lo, hi = bounds[k], bounds[k + 1]
+        if lo == hi:
+            continue
+        part, was, f = win[lo:hi], old[lo:hi], fill[lo:hi]
+        if k == 0:  # east: new[i, j] = old[i, j + 1]
+            part[..., :-1] = was[..., 1:]
+            part[..., -1] = f
+        elif k == 1:  # north: new[i, j] = old[i - 1, j]
+            part[..., 1:, :] = was[..., :-1, :]
+            part[..., 0, :] = f
+        elif k == 2:  # west: new[i, j] = old[i, j - 1]
+            part[..., 1:] = was[..., :-1]
+            part[..., 0] = f
+        else:  # south: new[i, j] = old[i + 1, j]
+            part[..., :-1, :] = was[..., 1:, :]
+            part[..., -1, :] = f
+        rr, cc = enter_win[k]
+        part[:, 1, rr, cc] = 1
+    return win
+
+
 def spread_info(info: dict, idx: np.ndarray, N: int) -> dict:
     """Info of worlds ``idx`` -> full ``(N,)`` arrays, zero and unmasked elsewhere."""
     out = {}

@@ -125,6 +125,7 @@ class World:
         rr, cc = rr + nr, cc + nc
         new = self._sweep_cells(rr, cc)
         s.row, s.col = s.believed_row, s.believed_col = nr, nc
+        s.y, s.x = float(nr), float(nc)
         s.travel += 1.0
         s.path.append((nr, nc))
         self._mark_believed(rr, cc)

@@ -315,3 +315,34 @@ def test_long_runs_equal_to_sync_vector_env(kwargs, num_envs, max_steps) -> None
     """Edge widths, sensor ranges and coarse resolutions over thousands of steps."""
     _, n_trunc = compare(num_envs, max_steps, 3000, seed=123, **kwargs)
     assert n_trunc > 0
+
+
+@pytest.mark.parametrize("line_of_sight", [False, True])
+def test_state_of_each_sub_environment_equals_the_single_env_state(line_of_sight: bool) -> None:
+    """The vector twin exports the single env's SweeperState (sweep counts stop at 2)."""
+    import dataclasses
+
+    kwargs = {"map_name": "room", "line_of_sight": line_of_sight, "render_mode": "rgb_array"}
+    native = SweeperVectorEnv(num_envs=3, max_episode_steps=10_000, **kwargs)
+    singles = [gym.make(ENV_ID, **kwargs).unwrapped for _ in range(3)]
+    native.reset(seed=9)
+    for i, env in enumerate(singles):
+        env.reset(seed=9 + i)
+    rng = np.random.default_rng(9)
+    for _ in range(400):
+        actions = rng.choice(3, size=3, p=[0.6, 0.2, 0.2])
+        native.step(actions)
+        for env, a in zip(singles, actions.tolist(), strict=True):
+            env.step(a)
+    for i, env in enumerate(singles):
+        got, want = native.state(i), env.state
+        for field in dataclasses.fields(want):
+            a, b = getattr(got, field.name), getattr(want, field.name)
+            if field.name == "sweeps":
+                b = np.minimum(b, 2)
+            if field.name == "scenario":
+                np.testing.assert_array_equal(a.obstacle, b.obstacle)
+                assert a.start == b.start
+                continue
+            np.testing.assert_array_equal(a, b, err_msg=field.name)
+        assert got.n_overswept > 0 and got.known_obstacles.any()
