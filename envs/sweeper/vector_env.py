@@ -9,7 +9,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from motiongym.envs.core import check_options, zero_terms
+from motiongym.envs.core import check_int, check_options, zero_terms
 from motiongym.envs.sweeper import sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
 from motiongym.envs.sweeper.measures import INFO_KEYS, batch_info, measures
@@ -26,6 +26,7 @@ from motiongym.envs.sweeper.vector_state import (
     spread_info,
 )
 
+MAX_NUM_ENVS = 65_536  # about 1 GiB of state and observations on the largest maps
 WINDOW_KEYS = ("sensed", "swept", "known")  # the planes of the kept windows, in order
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
 
@@ -34,7 +35,7 @@ class SweeperVectorEnv(VectorEnv):
     """N :class:`~motiongym.envs.sweeper.env.SweeperEnv` worlds in a few NumPy arrays.
 
     Step for step identical to ``gymnasium.vector.SyncVectorEnv`` over N
-    ``gym.make("motiongym/Sweeper-v0", max_episode_steps=...)`` with
+    ``gym.make("motiongym/Sweeper-v0" or "-v1", max_episode_steps=...)`` with
     ``autoreset_mode=AutoresetMode.SAME_STEP``: same observations (a dict of
     ``(N, ...)`` float32 arrays), rewards (float64), ``terminated``,
     ``truncated`` and ``info`` (each key an ``(N,)`` array with its ``_key``
@@ -66,6 +67,15 @@ class SweeperVectorEnv(VectorEnv):
     once. Odometry noise (``heading_noise``, ``slip_noise``) draws from each
     world's generator inside the step and is not batched: a non-zero value
     raises ValueError. Per-environment Python work happens only in resets.
+    ``num_envs`` is an integer in [1, 65536], ``max_episode_steps`` an
+    integer >= 1; the other keywords are the single environment's, checked
+    by :class:`~motiongym.envs.sweeper.params.SweeperParams`.
+
+    ## Actions
+    Exactly what ``action_space.contains`` accepts: a list or an array of
+    shape ``(N,)`` whose dtype casts safely to int64, values 0..2; anything
+    else a ValueError naming the space. ``state(i)`` gives sub-environment
+    ``i``'s :class:`~motiongym.envs.sweeper.state.SweeperState`.
 
     ## Returned observations
     The arrays of a returned observation are never written while anyone
@@ -95,10 +105,8 @@ class SweeperVectorEnv(VectorEnv):
         render_mode: str | None = None,
         **kwargs: Any,
     ) -> None:
-        if int(num_envs) != num_envs or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        if max_episode_steps is None or int(max_episode_steps) < 1:
-            raise ValueError(f"max_episode_steps must be >= 1, got {max_episode_steps!r}")
+        N = check_int("num_envs", num_envs, 1, MAX_NUM_ENVS)
+        max_episode_steps = check_int("max_episode_steps", max_episode_steps, 1)
         # The single environment validates the keywords and holds the spaces.
         self._single = single = SweeperEnv(render_mode=render_mode, **kwargs)
         self.params = p = single.params
@@ -108,8 +116,8 @@ class SweeperVectorEnv(VectorEnv):
                     f"{name}={getattr(p, name)!r}: odometry noise is not batched in "
                     "SweeperVectorEnv; use SyncVectorEnv of SweeperEnv for noisy runs"
                 )
-        self.num_envs = N = int(num_envs)
-        self.max_episode_steps = int(max_episode_steps)
+        self.num_envs = N
+        self.max_episode_steps = max_episode_steps
         self.render_mode = render_mode
         self.single_observation_space = single.observation_space
         self.observation_space = batch_space(single.observation_space, N)
@@ -422,22 +430,10 @@ class SweeperVectorEnv(VectorEnv):
         return dict(out)
 
     def _info(self, idx: Any, terms: dict[str, Any], bump: np.ndarray) -> dict:
-        n_swept, n_reach = self.n_swept[idx], self.n_reach[idx]
-        info = batch_info(
-            task.is_success(n_swept, n_reach),
-            bump,
-            terms,
-            **measures(
-                n_swept,
-                n_reach,
-                self.n_over[idx],
-                self.travel[idx],
-                self.turns[idx],
-                self.bumps[idx],
-                self.steps[idx],
-                self.w,
-            ),
-        )
+        counters = (self.n_swept, self.n_reach, self.n_over, self.travel, self.turns)
+        n_swept, n_reach, *rest = (a[idx] for a in (*counters, self.bumps, self.steps))
+        success = task.is_success(n_swept, n_reach)
+        info = batch_info(success, bump, terms, **measures(n_swept, n_reach, *rest, self.w))
         mask = np.ones(len(info["coverage"]), bool)
         for key in INFO_KEYS:
             info[f"_{key}"] = mask.copy()

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import sys
 from collections import deque
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -174,30 +175,23 @@ class ObservationPool:
 
 
 def check_actions(actions: Any, N: int) -> np.ndarray:
-    """``(N,)`` int actions in {0, 1, 2}; ValueError naming the problem otherwise."""
-    a = np.asarray(actions)
-    if a.shape not in ((N,), (N, 1)):
-        raise ValueError(
-            f"actions must have shape ({N},): one of 0 (forward), 1 (left), 2 (right) "
-            f"per sub-environment; got shape {a.shape}"
-        )
-    a = a.reshape(N)
-    if a.dtype.kind not in "iu":
-        if a.dtype.kind not in "fb":
-            raise ValueError(f"actions must be integers in {{0, 1, 2}}, got dtype {a.dtype}")
-        if a.dtype.kind == "f":
-            if np.isnan(a).any():
-                raise ValueError(f"actions contain NaN at indices {np.flatnonzero(np.isnan(a))}")
-            if (a != np.round(a)).any():
-                raise ValueError("actions must be integers in {0, 1, 2}, got fractional values")
-        a = a.astype(np.int64)
+    """``(N,)`` int64 actions: exactly what ``MultiDiscrete([3] * N).contains`` accepts
+    (a list or an array of shape ``(N,)``, a dtype that casts safely to int64,
+    values 0..2); anything else a ValueError naming the expected space."""
+    a = np.array(actions) if isinstance(actions, Sequence) else actions
+    expected = (
+        f"an integer array of shape ({N},) in MultiDiscrete([3] * {N}): "
+        "0 (forward), 1 (left) or 2 (right) per sub-environment"
+    )
+    if not isinstance(a, np.ndarray) or a.shape != (N,):
+        raise ValueError(f"actions must be {expected}; got shape {np.shape(a)}")
+    if not np.can_cast(a.dtype, np.int64):
+        raise ValueError(f"actions must be {expected}; got dtype {a.dtype}")
     bad = (a < 0) | (a > 2)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"actions must be 0 (forward), 1 (left) or 2 (right); sub-environment {k} got {a[k]}"
-        )
-    return a
+        raise ValueError(f"actions must be {expected}; sub-environment {k} got {a[k]}")
+    return a.astype(np.int64, copy=False)
 
 
 def shift_windows(

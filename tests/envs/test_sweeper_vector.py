@@ -228,15 +228,28 @@ def test_reset_options_reach_every_sub_environment() -> None:
         (np.zeros((4, 2), np.int64), "shape"),
         (np.array([0, 1, 3, 0]), "sub-environment 2 got 3"),
         (np.array([0, -1, 0, 0]), "sub-environment 1 got -1"),
-        (np.array([0.0, np.nan, 1.0, 2.0]), "NaN"),
-        (np.array([0.0, 0.5, 1.0, 2.0]), "integers"),
-        (np.array(["a", "b", "c", "d"]), "integers"),
+        (np.array([0.0, np.nan, 1.0, 2.0]), "got dtype float64"),
+        (np.array([0.0, 0.5, 1.0, 2.0]), "got dtype float64"),
+        (np.array([0.0, 1.0, 1.0, 2.0]), "got dtype float64"),  # as MultiDiscrete.contains
+        (np.array(["a", "b", "c", "d"]), "got dtype <U1"),
+        (np.zeros((4, 1), np.int64), r"shape \(4,\) in MultiDiscrete\(\[3\] \* 4\)"),
+        ("0101", "got shape"),
+        (np.array([0, 1, 2, 2], np.uint64), "got dtype uint64"),
     ],
 )
 def test_bad_actions_raise(actions, match) -> None:
     env = SweeperVectorEnv(num_envs=4)
     env.reset(seed=0)
+    assert not env.action_space.contains(actions)
     with pytest.raises(ValueError, match=match):
+        env.step(actions)
+
+
+def test_accepts_what_the_action_space_contains() -> None:
+    env = SweeperVectorEnv(num_envs=4)
+    env.reset(seed=0)
+    for actions in ([0, 1, 2, 0], np.array([2, 1, 0, 0], np.uint8), np.ones(4, bool)):
+        assert env.action_space.contains(actions)
         env.step(actions)
 
 
@@ -247,8 +260,12 @@ def test_bad_construction_raises() -> None:
         SweeperVectorEnv(num_envs=2, slip_noise=0.1)
     with pytest.raises(ValueError, match="map_name must be one of"):
         SweeperVectorEnv(num_envs=2, map_name="castle")
-    with pytest.raises(ValueError, match="num_envs"):
+    with pytest.raises(ValueError, match=r"num_envs must be an integer in \[1, 65536\], got 0"):
         SweeperVectorEnv(num_envs=0)
+    with pytest.raises(ValueError, match="num_envs must be an integer"):
+        SweeperVectorEnv(num_envs=2.5)
+    with pytest.raises(ValueError, match="max_episode_steps must be an integer >= 1, got None"):
+        SweeperVectorEnv(num_envs=2, max_episode_steps=None)
     with pytest.raises(RuntimeError, match="reset"):
         SweeperVectorEnv(num_envs=2).step(np.zeros(2, np.int64))
 
