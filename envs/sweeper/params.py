@@ -19,6 +19,7 @@ from motiongym.envs.core import (
     check_choice,
     check_float,
     check_int,
+    check_shape,
     params_from_kwargs,
 )
 from motiongym.envs.sweeper import generator, maps
@@ -43,7 +44,8 @@ class SweeperParams:
                              "random-room", "random-apartment", "random-maze"
     map_file       None      a path (str or os.PathLike) to a .txt or .png map;
                              overrides ``map_name``
-    grid           None      an (H, W) bool array; overrides both
+    grid           None      an (H, W) array of bools or finite numbers
+                             (nonzero: obstacle), at most 256 a side; overrides both
     robot_width    3         integer cells in [1, 10]
     sensor_range   None      integer cells in [1, 16] beyond the footprint;
                              None: ``robot_width``
@@ -83,6 +85,8 @@ class SweeperParams:
         check_choice("map_name", self.map_name, MAP_CHOICES)
         if self.map_file is not None and not isinstance(self.map_file, (str, os.PathLike)):
             raise ArgumentError(f"map_file must be None or a path, got {self.map_file!r}")
+        if self.grid is not None:  # its size, closedness and room: maps.validate_map
+            check_shape("grid", self.grid, (None, None))
         w = check_int("robot_width", self.robot_width, 1, MAX_ROBOT_WIDTH)
         R = w if self.sensor_range is None else self.sensor_range
         R = check_int("sensor_range", R, 1, MAX_SENSOR_RANGE)
