@@ -74,10 +74,12 @@ class SweeperEnv(NeedsReset, gym.Env):
                            covers a ``ceil(H/K) x ceil(W/K)`` block of the
                            map and holds the fraction swept
     obstacle_map  (K*K,)   same blocks: fraction of known obstacle cells
-    known         (S*S,)   v1 only: 1.0 for a window cell sensed on this step
-                           (visible from the footprint), 0.0 for unknown;
-                           same layout as ``sensed``, which in v1 is 1.0
-                           only for a sensed obstacle (0.0: free or unknown)
+    known         (S*S,)   v1 only: 1.0 for a window cell sensed at the
+                           current pose (visible from the footprint; the
+                           window is read after every move), 0.0 for
+                           unknown; same layout as ``sensed``, which in v1
+                           is 1.0 only for a sensed obstacle (0.0: free or
+                           unknown)
     ============= ======== ===================================================
 
     Everything is float32 in [0, 1] except ``pose`` (rows/columns up to 256).
