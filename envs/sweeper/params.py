@@ -63,7 +63,7 @@ class SweeperParams:
     Maps are at most 256 cells a side (:data:`maps.MAX_SIDE`), checked when
     the map is loaded. So the sensing window has at most ``S = 10 + 2 * 16 =
     42`` cells a side, a step touches at most ``S^2`` cells (and, with line
-    of sight, about ``S^3 w^2 / 2`` = 3.7 M line entries, built once), and a
+    of sight, a product over at most 2.36 M line entries, built once), and a
     frame has at most ``8,192^2`` pixels.
     """
 

@@ -102,3 +102,10 @@ def test_v1_belief_holds_only_sensed_obstacles() -> None:
             obs, *_ = env.step(int(rng.choice(3, p=[0.6, 0.2, 0.2])))
         totals[env_id] = float(obs["obstacle_map"].sum())
     assert totals["motiongym/Sweeper-v1"] < totals["motiongym/Sweeper-v0"]
+
+
+def test_ray_matrix_size_for_the_default_robot() -> None:
+    """The size the docstring states for the default robot (w = 3, R = 3)."""
+    assert sight.ray_matrix(3, 3).nnz == 1544
+    S, w = 3 + 2 * 3, 3
+    assert sight.ray_matrix(3, 3).shape == (S * S * w * w, S * S)
