@@ -45,7 +45,8 @@ class SweeperParams:
     map_file       None      a path (str or os.PathLike) to a .txt or .png map;
                              overrides ``map_name``
     grid           None      an (H, W) array of bools or finite numbers
-                             (nonzero: obstacle), at most 256 a side; overrides both
+                             (nonzero: obstacle), at most 256 a side;
+                             overrides both
     robot_width    3         integer cells in [1, 10]
     sensor_range   None      integer cells in [1, 16] beyond the footprint;
                              None: ``robot_width``
