@@ -8,6 +8,7 @@ import gymnasium as gym
 
 from motiongym.agents.errors import UsageError
 from motiongym.envs import ENV_IDS
+from motiongym.envs.core import ArgumentError
 
 
 def check_env_id(env_id: str) -> str:
@@ -27,7 +28,7 @@ def make_env(env_id: str, env_kwargs: dict[str, Any] | None = None, **make_kwarg
     check_env_id(env_id)
     try:
         return gym.make(env_id, **(env_kwargs or {}), **make_kwargs)
-    except TypeError as error:
+    except (TypeError, ArgumentError) as error:
         raise UsageError(f"bad keyword for {env_id}: {error}") from error
 
 

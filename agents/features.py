@@ -45,15 +45,19 @@ def _rotated(grid: torch.Tensor) -> torch.Tensor:
     return torch.stack([torch.rot90(grid, k).flatten() for k in range(4)])
 
 
+WINDOW_KEYS = ("sensed", "swept", "known")  # the local windows, in this order where present
+
+
 class SweeperEgocentric(BaseFeaturesExtractor):
     """The sweeper's observation in the robot's frame, through a small CNN.
 
     Inputs (see ``SweeperEnv``'s observation table), for a batch of ``B``:
 
-    - local windows ``sensed`` and ``swept`` ``(S, S)`` around the footprint,
-      turned ``(1 - heading) mod 4`` quarter turns counter-clockwise so that
-      the heading points up (the footprint is at the window's centre, so the
-      turn keeps it there): ``2 S^2`` features, flattened;
+    - local windows ``sensed``, ``swept`` and, where the observation has it
+      (``Sweeper-v1``), ``known`` ``(S, S)`` around the footprint, turned
+      ``(1 - heading) mod 4`` quarter turns counter-clockwise so that the
+      heading points up (the footprint is at the window's centre, so the
+      turn keeps it there): ``2 S^2`` or ``3 S^2`` features, flattened;
     - coarse maps ``sweep_map`` and ``obstacle_map`` ``(K, K)``: block
       ``(i, j)`` covers cells ``[i bh, (i+1) bh) x [j bw, (j+1) bw)`` with
       ``bh, bw = ceil(H / K), ceil(W / K)``. The robot's block is that of its
@@ -92,6 +96,7 @@ class SweeperEgocentric(BaseFeaturesExtractor):
             raise ValueError(f"channels must be positive integers, got {channels!r}")
         S = math.isqrt(observation_space["sensed"].shape[0])
         K = math.isqrt(observation_space["sweep_map"].shape[0])
+        self.window_keys = tuple(k for k in WINDOW_KEYS if k in observation_space.spaces)
         self.K = K
         self.register_buffer("map_size", torch.tensor(shape, dtype=torch.float32))
         self.block = (-(-shape[0] // K), -(-shape[1] // K))  # (bh, bw), cells
@@ -110,7 +115,7 @@ class SweeperEgocentric(BaseFeaturesExtractor):
         if side < 1:
             raise ValueError(f"{len(channels)} stride-2 convolutions shrink a {2 * K - 1} map to 0")
         self.cnn = nn.Sequential(*layers, nn.Flatten())
-        n_inputs = 2 * S * S + in_channels * side * side + 2 + 4 + 1
+        n_inputs = len(self.window_keys) * S * S + in_channels * side * side + 2 + 4 + 1
         self.head = nn.Sequential(nn.Linear(n_inputs, features_dim), nn.ReLU())
 
     def egocentric_maps(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
@@ -128,11 +133,10 @@ class SweeperEgocentric(BaseFeaturesExtractor):
         return torch.stack([swept, obstacle, 1.0 - inside], 1).reshape(-1, 3, side, side)
 
     def egocentric_windows(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
-        """``(B, 2, S^2)``: the sensed and swept windows turned heading-up, flattened."""
+        """``(B, 2 or 3, S^2)``: the windows (sensed, swept, known) turned heading-up."""
         k = _quarter_turns(_heading(observations["pose"]))
         index = self.window_index[k]  # (B, S^2)
-        windows = (observations["sensed"].gather(1, index), observations["swept"].gather(1, index))
-        return torch.stack(windows, 1)
+        return torch.stack([observations[key].gather(1, index) for key in self.window_keys], 1)
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         pose = observations["pose"]

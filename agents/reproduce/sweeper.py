@@ -9,7 +9,7 @@ writes into ``out_dir`` (``sweeper.json`` and PNG figures):
    (reachable area / W) and the bound of Icking, Kamphans and Langetepe's
    online grid exploration (SmartDFS's ``C + E/2 - 3`` without holes,
    ``C + E/2 + 3H - 2`` around H obstacles;
-   :func:`motiongym.envs.sweeper.world.smartdfs_bound`), beside the
+   :func:`motiongym.envs.sweeper.occupancy.smartdfs_bound`), beside the
    no-hole formula on every map (stricter), and the travel split into
    lanes, shifts, transfers between runs and corner work. Both bounds are
    for a tour back to the start; our travel does not return, so the check
@@ -40,7 +40,7 @@ import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
 from motiongym.baselines.sweeper.run import make_policy, run_episode
-from motiongym.envs.sweeper import generator, maps, world
+from motiongym.envs.sweeper import generator, maps, occupancy
 
 ENV_ID = "motiongym/Sweeper-v0"
 W = 3  # robot width (cells) of all studies
@@ -65,10 +65,10 @@ def _episode(env: gym.Env, policy: str, seed: int | None, options=None, max_step
     return out
 
 
-def _bound(env: gym.Env) -> world.SmartDfsBound:
+def _bound(env: gym.Env) -> occupancy.SmartDfsBound:
     """The exploration bound of the episode just run (robot-scale cells anchored at its start)."""
     sc = env.unwrapped.scenario
-    return world.smartdfs_bound(sc.reachable, W, sc.start)
+    return occupancy.smartdfs_bound(sc.reachable, W, sc.start)
 
 
 def _shares(runs: list[dict]) -> dict[str, float]:
@@ -116,7 +116,7 @@ def coverage_study(quick: bool) -> dict:
     return out
 
 
-def _travel_against_bounds(runs: list[dict], bounds: list[world.SmartDfsBound]) -> dict:
+def _travel_against_bounds(runs: list[dict], bounds: list[occupancy.SmartDfsBound]) -> dict:
     """Coverage, travel ratio and both exploration bounds over ``runs`` (one bound per run)."""
     ratios = np.array([r["travel_ratio"] for r in runs])
     theorem = np.array([b.ratio for b in bounds])
@@ -138,7 +138,7 @@ def start_position_study(quick: bool) -> dict:
     """Travel from every feasible start configuration of the maze (heading east)."""
     env = _env(map_name="maze")
     grid = maps.shipped_map("maze")
-    free = world.config_free(grid, W)
+    free = occupancy.config_free(grid, W)
     stride = 4 if quick else 1
     starts = [tuple(int(v) for v in p) for p in np.argwhere(free) if p[0] % stride == 0]
     starts = [p for p in starts if p[1] % stride == 0]
@@ -162,7 +162,7 @@ def _rotated_start(grid: np.ndarray, angle: float, start: tuple[int, int]) -> tu
     turned = maps.rotate_map(~mark, angle)  # the marked block stays "free"
     turned[0, :] = turned[-1, :] = turned[:, 0] = turned[:, -1] = True
     centre = np.argwhere(~turned).mean(axis=0) - (W - 1) / 2
-    free = world.config_free(maps.rotate_map(grid, angle), W)
+    free = occupancy.config_free(maps.rotate_map(grid, angle), W)
     cells = np.argwhere(free)
     k = int(np.argmin(((cells - centre) ** 2).sum(axis=1)))
     return int(cells[k, 0]), int(cells[k, 1])
@@ -190,7 +190,7 @@ def orientation_study(quick: bool) -> dict:
     the paper's 3 %.
     """
     env = _env(map_name="maze")
-    free = world.config_free(maps.shipped_map("maze"), W)
+    free = occupancy.config_free(maps.shipped_map("maze"), W)
     cells = np.argwhere(free)
     pick = np.random.default_rng(0).choice(len(cells), 4 if quick else 16, replace=False)
     starts = [(2, 2)] + [(int(cells[k, 0]), int(cells[k, 1])) for k in np.sort(pick)]
@@ -203,7 +203,7 @@ def orientation_study(quick: bool) -> dict:
             if start == starts[0]:
                 rows.append(
                     {
-                        "heading": world.HEADING_NAMES[heading],
+                        "heading": occupancy.HEADING_NAMES[heading],
                         "travel": r["travel"],
                         "travel_ratio": r["travel_ratio"],
                         "coverage": r["coverage"],
@@ -238,7 +238,7 @@ def walls_turned_study(quick: bool) -> dict:
                 "travel_ratio": r["travel_ratio"],
                 "coverage": r["coverage"],
                 "left_to_cwa": 1.0 - r["psa_coverage"],
-                "reachable": int(env.unwrapped.n_reach),
+                "reachable": env.unwrapped.state.n_reachable,
             }
         )
     return {

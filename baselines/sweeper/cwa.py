@@ -35,12 +35,12 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from motiongym.envs.sweeper import world
+from motiongym.envs.sweeper import occupancy
 
 
 def leftovers(occ: np.ndarray, swept: np.ndarray, reach: np.ndarray, w: int) -> np.ndarray:
     """``(H, W)`` bool: cells neither swept nor obstacle, covered by a reachable configuration."""
-    return world.footprint_union(reach, w) & ~swept & (occ != 1)
+    return occupancy.footprint_union(reach, w) & ~swept & (occ != 1)
 
 
 def scan_groups(
@@ -96,7 +96,7 @@ def nearest_cover(dist: np.ndarray, cells: np.ndarray, w: int) -> tuple[int, int
     mark = np.zeros(dist.shape, np.int64)
     mark[cells[:, 0], cells[:, 1]] = 1
     # configurations (r, c) with r <= i < r + w: a box sum anchored at (r, c)
-    count = world.box_sum(mark, w)
+    count = occupancy.box_sum(mark, w)
     ok = (count > 0) & (dist >= 0)
     if not ok.any():
         return None

@@ -44,7 +44,7 @@ Choices where the paper is open (documented and tested):
   ratio over room seeds 0-19, maze seeds 0-19, apartment seeds 0-29 and the
   reproduction's 50 procedural maps: 1.339 / 1.486 / 1.603 / 1.389 without,
   1.337 / 1.490 / 1.554 / 1.381 with; apartment starts below the
-  exploration bound (:func:`motiongym.envs.sweeper.world.smartdfs_bound`)
+  exploration bound (:func:`motiongym.envs.sweeper.occupancy.smartdfs_bound`)
   22 -> 27 of 30. Looking behind a restarted run's first lane as well cost
   on the room (1.367) and gained little elsewhere; not done.
 - A pushed entry keeps its whole side segment (start, heading, length, side):
@@ -100,7 +100,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.sweeper.world import DC, DR, box_sum
+from motiongym.envs.sweeper.occupancy import DC, DR, box_sum
 
 
 @dataclass(frozen=True)

@@ -23,8 +23,9 @@ from gymnasium import spaces
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper import cwa, psa, quadtree
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
-from motiongym.envs.sweeper import world
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper import occupancy
+from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.params import SweeperParams
 
 FORWARD, LEFT, RIGHT = 0, 1, 2
 
@@ -36,7 +37,7 @@ def turn_towards(heading: int, target: int) -> int:
 
 def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:
     """``(w, R)``: the robot width (from the env's keywords) and sensing range (window size)."""
-    w = int(env_kwargs.get("robot_width", 3))
+    w = SweeperParams.from_kwargs(env_kwargs).robot_width
     s = int(round(np.sqrt(observation_space["sensed"].shape[0])))
     return w, (s - w) // 2
 
@@ -107,7 +108,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         return LEFT  # pragma: no cover - a planning loop that does not settle
 
     def _mark_ahead(self, m: Memory, r: int, c: int, h: int) -> None:
-        rr, cc = np.nonzero(world.entering_mask(int(DR[h]), int(DC[h]), self.w))
+        rr, cc = np.nonzero(occupancy.entering_mask(int(DR[h]), int(DC[h]), self.w))
         m.map.mark_obstacle(rr + r + int(DR[h]), cc + c + int(DC[h]))
 
     def _follow(self, m: Memory, r: int, c: int, h: int) -> int | None:
@@ -127,7 +128,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     def _known(self, m: Memory, r: int, c: int):
         """Known-map arrays on the explored box: origin, occupancy, swept, free configs, start."""
         r0, c0, occ, swept = m.map.window()
-        cfree = world.config_free(occ == OBSTACLE, self.w)
+        cfree = occupancy.config_free(occ == OBSTACLE, self.w)
         cur = (r - r0, c - c0)
         cfree[cur] = True  # the robot stands there, whatever the map says
         return (r0, c0), occ, swept, cfree, cur
@@ -143,7 +144,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return turn_towards(h, m.run_heading)
         nr, nc = r + int(DR[h]), c + int(DC[h])
         occ, sw = m.map.footprint(nr, nc)
-        edge = world.entering_mask(int(DR[h]), int(DC[h]), self.w)
+        edge = occupancy.entering_mask(int(DR[h]), int(DC[h]), self.w)
         if psa.lane_open(occ, sw[edge]):
             return FORWARD  # step 1: straight on, sweeping
         for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
@@ -217,7 +218,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         if ((~sw) & (occ != OBSTACLE)).any():
             return True
         nocc, nsw = m.map.footprint(cfg[0] + int(DR[heading]), cfg[1] + int(DC[heading]))
-        edge = world.entering_mask(int(DR[heading]), int(DC[heading]), self.w)
+        edge = occupancy.entering_mask(int(DR[heading]), int(DC[heading]), self.w)
         return psa.lane_open(nocc, nsw[edge])
 
     def _shift(self, m: Memory, r: int, c: int, h: int) -> int | None:
@@ -258,7 +259,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         entries for ever. The ``nearest`` ablation considers every entry.
         """
         origin, occ, swept, cfree, cur = self._known(m, r, c)
-        dist = world.bfs_distance(cfree, cur)
+        dist = occupancy.bfs_distance(cfree, cur)
         todo = psa.covers_unswept(occ, swept, self.w)
 
         def restart(seg: psa.Segment) -> tuple[tuple[int, int], int] | None:
@@ -328,14 +329,14 @@ class PsaCwaPolicy(ScriptedPolicy):
     # -------------------------------------------------------------- CWA modes
     def _cwa_scan(self, m: Memory, r: int, c: int, h: int) -> int | None:
         origin, occ, swept, cfree, cur = self._known(m, r, c)
-        reach = world.reachable_configs(cfree, cur)
+        reach = occupancy.reachable_configs(cfree, cur)
         targets = cwa.leftovers(occ, swept, reach, self.w)
         state = (int(m.map.swept.sum()), int(targets.sum()))
         if not targets.any() or state == m.cwa_last:
             m.mode = "done"
             return None
         m.cwa_last = state
-        wide = (world.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
+        wide = (occupancy.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
         if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
             return self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
         m.cwa_stack = [
@@ -352,7 +353,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         and shifts to the perpendicular with the longer one; on arrival
         :func:`.psa.restart_heading` may turn the lanes to the other axis.
         """
-        dist = world.bfs_distance(cfree, cur)
+        dist = occupancy.bfs_distance(cfree, cur)
         d = np.where(wide & (dist >= 0), dist, np.iinfo(np.int64).max)
         target = divmod(int(np.argmin(d)), d.shape[1])
         todo = psa.covers_unswept(np.where(targets, 0, 1), targets, self.w) & cfree
@@ -375,7 +376,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     def _cwa_pop(self, m: Memory, r: int, c: int, h: int) -> int | None:
         if self.cwa_order == "nearest" and len(m.cwa_stack) > 1:
             origin, _, _, cfree, cur = self._known(m, r, c)
-            dist = world.bfs_distance(cfree, cur)
+            dist = occupancy.bfs_distance(cfree, cur)
             best, best_k = None, len(m.cwa_stack) - 1
             for k, (_, cells) in enumerate(m.cwa_stack):
                 cells = self._remaining(m, cells)
@@ -393,7 +394,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             if not len(cells):
                 continue
             origin, occ, swept, cfree, cur = self._known(m, r, c)
-            dist = world.bfs_distance(cfree, cur)
+            dist = occupancy.bfs_distance(cfree, cur)
             first = self._remaining(m, np.array([seed]))
             aim = first if len(first) else cells
             target = cwa.nearest_cover(dist, aim - np.array(origin), self.w)
@@ -416,12 +417,14 @@ class PsaCwaPolicy(ScriptedPolicy):
             m.mode = "cwa_pop"
             return None
         origin, _, _, cfree, cur = self._known(m, r, c)
-        dist = world.bfs_distance(cfree, cur)
+        dist = occupancy.bfs_distance(cfree, cur)
         target = cwa.nearest_cover(dist, cells - np.array(origin), self.w)
         if target is None:
             m.mode = "cwa_pop"
             return None
-        m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in world.descend(dist, target))
+        m.path = deque(
+            (p[0] + origin[0], p[1] + origin[1]) for p in occupancy.descend(dist, target)
+        )
         if not m.path:  # standing on it, yet cells remain: they are not coverable from here
             m.mode = "cwa_pop"
         return None

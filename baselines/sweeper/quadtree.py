@@ -35,8 +35,8 @@ import heapq
 
 import numpy as np
 
-from motiongym.envs.sweeper import world
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper import occupancy
+from motiongym.envs.sweeper.occupancy import DC, DR
 
 
 def decompose(free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -146,8 +146,8 @@ def best_path(
     the distance layers of the cells that lie on a shortest path. Returns
     the cells from ``start`` (excluded) to ``goal``; ``goal`` must be reachable.
     """
-    ds = world.bfs_distance(corridor, start)
-    dg = world.bfs_distance(corridor, goal)
+    ds = occupancy.bfs_distance(corridor, start)
+    dg = occupancy.bfs_distance(corridor, goal)
     n = int(ds[goal])
     on = (ds >= 0) & (dg >= 0) & (ds + dg == n)
     value = np.full(corridor.shape, -1, np.int64)

@@ -8,7 +8,7 @@ split by what the robot was doing (``travel_by_mode``: lanes, shifts,
 transfers between runs, corner work).
 
 The travel goal is set by SmartDFS's bound,
-:func:`motiongym.envs.sweeper.world.smartdfs_bound`.
+:func:`motiongym.envs.sweeper.occupancy.smartdfs_bound`.
 """
 
 from __future__ import annotations

@@ -10,4 +10,11 @@ REGISTRATIONS: tuple[dict, ...] = (
         "max_episode_steps": 20_000,
         "kwargs": {"map_name": "room", "robot_width": 3},
     },
+    {
+        "id": "motiongym/Sweeper-v1",
+        "entry_point": "motiongym.envs.sweeper.env:SweeperEnv",
+        "vector_entry_point": "motiongym.envs.sweeper.vector_env:SweeperVectorEnv",
+        "max_episode_steps": 20_000,
+        "kwargs": {"map_name": "room", "robot_width": 3, "line_of_sight": True},
+    },
 )

@@ -23,7 +23,7 @@ import pathlib
 import numpy as np
 from scipy import ndimage
 
-from motiongym.envs.sweeper.world import is_closed
+from motiongym.envs.sweeper.occupancy import config_free, is_closed
 
 MAPS_DIR = pathlib.Path(__file__).with_name("map_files")
 SHIPPED_MAPS = ("room", "apartment", "maze")
@@ -31,24 +31,40 @@ MAX_SIDE = 256  # largest map side (cells) the observation space allows
 
 
 class MapError(ValueError):
-    """A map that cannot be used: missing, empty of free cells, or not closed."""
+    """A map that cannot be used; the one-line message names the line and column.
+
+    Text maps count lines and columns from 1, as editors do; bitmaps (arrays,
+    PNG) count rows and columns from 0, as NumPy does.
+    """
 
 
 def parse_text_map(text: str, source: str = "<text>") -> np.ndarray:
-    """Parse ``#``/``.`` rows into an ``(H, W)`` bool obstacle array."""
-    rows = [line.rstrip("\n\r") for line in text.splitlines() if line.strip()]
-    if not rows:
+    """Parse ``#``/``.`` rows into an ``(H, W)`` bool obstacle array.
+
+    Every line must have the same length and hold only ``#`` and ``.``
+    (blank lines after the map are ignored), so that line ``i`` is row ``i - 1``.
+    """
+    lines = text.splitlines()
+    if not any(line.strip() for line in lines):
         raise MapError(f"map {source} is empty")
-    width = max(len(row) for row in rows)
-    grid = np.ones((len(rows), width), dtype=bool)
-    for i, row in enumerate(rows):
-        bad = set(row) - {"#", "."}
-        if bad:
+    first, last = 0, max(k for k, line in enumerate(lines) if line.strip())
+    width = len(lines[first])
+    grid = np.ones((last - first + 1, width), dtype=bool)
+    for i in range(first, last + 1):
+        row = lines[i]
+        for j, char in enumerate(row):
+            if char not in "#.":
+                raise MapError(
+                    f"map {source} line {i + 1}, column {j + 1}: character {char!r}; "
+                    "use '#' (obstacle) and '.' (free)"
+                )
+        if len(row) != width:
+            column = min(len(row), width) + 1
             raise MapError(
-                f"map {source} row {i} has characters {sorted(bad)}; "
-                "use '#' (obstacle) and '.' (free)"
+                f"map {source} line {i + 1}, column {column}: ragged rows, this line has "
+                f"{len(row)} cells where line {first + 1} has {width}"
             )
-        grid[i, : len(row)] = np.frombuffer(row.encode(), dtype=np.uint8) == ord("#")
+        grid[i - first] = np.frombuffer(row.encode(), dtype=np.uint8) == ord("#")
     return grid
 
 
@@ -57,8 +73,8 @@ def to_text(grid: np.ndarray) -> str:
     return "\n".join("".join("#" if v else "." for v in row) for row in grid) + "\n"
 
 
-def load_map_file(path: str | pathlib.Path) -> np.ndarray:
-    """Load a user map from a ``.txt`` or ``.png`` file and validate it."""
+def load_map_file(path: str | pathlib.Path, w: int = 1) -> np.ndarray:
+    """Load a user map from a ``.txt`` or ``.png`` file and validate it for robot width ``w``."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"map file {str(path)!r} does not exist")
@@ -67,16 +83,27 @@ def load_map_file(path: str | pathlib.Path) -> np.ndarray:
         from PIL import Image
 
         grey = np.asarray(Image.open(path).convert("L"))
-        grid = grey < 128
+        grid, text = grey < 128, False
     elif suffix in (".txt", ".map"):
-        grid = parse_text_map(path.read_text(), source=repr(str(path)))
+        grid, text = parse_text_map(path.read_text(), source=repr(str(path))), True
     else:
         raise MapError(f"map file {str(path)!r}: unknown format {suffix!r}; use .txt or .png")
-    return validate_map(grid, source=repr(str(path)))
+    return validate_map(grid, w, source=f"map {str(path)!r}", text=text)
 
 
-def validate_map(grid: np.ndarray, w: int = 1, source: str = "map") -> np.ndarray:
-    """Check shape, closedness and free space; return the map as a bool array."""
+def _cell(r: int, c: int, text: bool) -> str:
+    """Where a cell is, as the user counts: text lines from 1, bitmap rows from 0."""
+    return f"line {r + 1}, column {c + 1}" if text else f"row {r}, column {c}"
+
+
+def validate_map(
+    grid: np.ndarray, w: int = 1, source: str = "map", text: bool = False
+) -> np.ndarray:
+    """Check shape, closedness and room for a ``w x w`` robot; return the map as a bool array.
+
+    ``text``: name cells by line and column from 1 (a text map) rather than
+    by row and column from 0.
+    """
     grid = np.asarray(grid, dtype=bool)
     if grid.ndim != 2:
         raise MapError(f"{source}: expected a 2-D bitmap, got shape {grid.shape}")
@@ -90,8 +117,15 @@ def validate_map(grid: np.ndarray, w: int = 1, source: str = "map") -> np.ndarra
         on_border |= cols == grid.shape[1] - 1
         k = int(np.argmax(on_border))
         raise MapError(
-            f"{source} is not closed: free cell ({rows[k]}, {cols[k]}) lies on the border; "
-            "surround the area with obstacle cells"
+            f"{source} is not closed: {_cell(int(rows[k]), int(cols[k]), text)} is a free "
+            "cell on the border; surround the area with obstacle cells"
+        )
+    if not config_free(grid, w).any():
+        k = max(v for v in range(1, w) if config_free(grid, v).any()) if w > 1 else 0
+        r, c = np.argwhere(config_free(grid, k))[0] if k else (0, 0)
+        raise MapError(
+            f"{source} has no free place for a robot of width {w}: the widest free "
+            f"square is {k} x {k} cells, at {_cell(int(r), int(c), text)} (its top-left)"
         )
     return grid
 

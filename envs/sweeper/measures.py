@@ -1,4 +1,4 @@
-"""The sweeper's reward terms and ``info`` of a step, for one world or a batch.
+"""The sweeper's measures in ``info``, for one world or a batch.
 
 Shared by :class:`~motiongym.envs.sweeper.env.SweeperEnv` (Python scalars)
 and its NumPy-batched twin (arrays over sub-environments), so that both
@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from motiongym.envs.sweeper.task import REWARD_TERMS
+
 INFO_KEYS = (
     "is_success",
     "cost",
@@ -21,45 +23,20 @@ INFO_KEYS = (
     "turns",
     "bumps",
     "steps",
-    "reward_sweep",
-    "reward_time",
-    "reward_bump",
+    *(f"reward_{term}" for term in REWARD_TERMS),
 )
 
 
-def reward_terms(
-    new_cells: Any, bump: Any, w: int, sweep_reward: float, time_reward: float, bump_reward: float
-) -> tuple[Any, float, Any]:
-    """``(sweep, time, bump)``: ``sweep_reward`` per fresh lane cell (newly swept
-    reachable cells over the robot width ``w``), the step cost, the bump penalty."""
-    r_sweep = sweep_reward * new_cells / w
-    r_bump = np.where(bump, bump_reward, 0.0) if np.ndim(bump) else (bump_reward if bump else 0.0)
-    return r_sweep, time_reward, r_bump
-
-
-def step_info(
-    n_swept: Any,
-    n_reach: Any,
-    n_over: Any,
-    travel: Any,
-    turns: Any,
-    bumps: Any,
-    steps: Any,
-    w: int,
-    bump: Any,
-    rewards: tuple[Any, float, Any],
+def measures(
+    n_swept: Any, n_reach: Any, n_over: Any, travel: Any, turns: Any, bumps: Any, steps: Any, w: int
 ) -> dict[str, Any]:
-    """The ``info`` of a step (see ``SweeperEnv``'s docstring for the keys).
+    """``coverage``, ``travel``, ``travel_ratio``, ``overlap``, ``turns``, ``bumps``, ``steps``.
 
     Counters are scalars for one world or arrays for a batch; batched values
     are copied, so later steps never change a returned ``info``.
     """
-    batched = np.ndim(n_swept) > 0
-    own = np.array if batched else (lambda value: value)
-    r_sweep, r_time, r_bump = rewards
+    own = np.array if isinstance(n_swept, np.ndarray) else (lambda value: value)
     return {
-        "is_success": n_swept >= n_reach,
-        "cost": np.asarray(bump, np.float64) if batched else (1.0 if bump else 0.0),
         "coverage": n_swept / n_reach,
         "travel": own(travel),
         "travel_ratio": travel * w / n_reach,
@@ -67,7 +44,17 @@ def step_info(
         "turns": own(turns),
         "bumps": own(bumps),
         "steps": own(steps),
-        "reward_sweep": np.asarray(r_sweep, np.float64) if batched else r_sweep,
-        "reward_time": np.full(np.shape(n_swept), r_time, np.float64) if batched else r_time,
-        "reward_bump": np.asarray(r_bump, np.float64) if batched else r_bump,
     }
+
+
+def batch_info(
+    is_success: np.ndarray, bump: np.ndarray, terms: dict[str, Any], **measured: Any
+) -> dict[str, Any]:
+    """A batch's ``info`` as :func:`motiongym.envs.core.reward_and_info` lays out one
+    world's: ``is_success``, ``cost``, the measures and ``reward_<term>`` (float64)."""
+    n = len(is_success)
+    info: dict[str, Any] = {"is_success": is_success, "cost": np.asarray(bump, np.float64)}
+    info.update(measured)
+    for key, value in terms.items():
+        info[f"reward_{key}"] = np.broadcast_to(np.asarray(value, np.float64), (n,)).copy()
+    return info

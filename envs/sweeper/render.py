@@ -2,14 +2,10 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from motiongym.envs.sweeper.world import DC, DR
-
-if TYPE_CHECKING:
-    from motiongym.envs.sweeper.env import SweeperEnv
+from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.state import SweeperState
 
 OBSTACLE = np.array([20, 20, 20], np.uint8)
 UNREACHABLE = np.array([150, 150, 170], np.uint8)
@@ -21,29 +17,32 @@ ROBOT = np.array([220, 40, 40], np.uint8)
 BELIEVED = np.array([250, 160, 0], np.uint8)
 
 
-def draw(env: SweeperEnv, px: int = 8) -> np.ndarray:
-    """``(H * px, W * px, 3)`` uint8 image of ``env``'s current state."""
-    sc = env.scenario
+def draw(state: SweeperState, w: int, px: int = 8) -> np.ndarray:
+    """``(H * px, W * px, 3)`` uint8 image of a world's ``state`` (robot width ``w``).
+
+    The believed footprint is outlined too where odometry error moved it off
+    the true one.
+    """
+    sc = state.scenario
     h, wd = sc.obstacle.shape
     img = np.empty((h, wd, 3), np.uint8)
     img[:] = FREE
     img[~sc.reachable & ~sc.obstacle] = UNREACHABLE
     img[sc.obstacle] = OBSTACLE
-    img[env.sweeps == 1] = SWEPT
-    img[env.sweeps > 1] = OVERSWEPT
+    img[state.sweeps == 1] = SWEPT
+    img[state.sweeps > 1] = OVERSWEPT
     img = img.repeat(px, axis=0).repeat(px, axis=1)
-    w = env.w
     centre = (w * px) // 2
     dot = max(1, px // 4)
-    for r, c in env.path:  # path of the footprint centre
+    for r, c in state.path:  # path of the footprint centre
         y, x = r * px + centre, c * px + centre
         img[y - dot : y + dot, x - dot : x + dot] = PATH
-    if env.noisy:
-        _square(img, env.br * px, env.bc * px, w * px, BELIEVED)
-    _square(img, env.r * px, env.c * px, w * px, ROBOT)
-    y, x = env.r * px + centre, env.c * px + centre
+    if (state.believed_row, state.believed_col) != (state.row, state.col):
+        _square(img, state.believed_row * px, state.believed_col * px, w * px, BELIEVED)
+    _square(img, state.row * px, state.col * px, w * px, ROBOT)
+    y, x = state.row * px + centre, state.col * px + centre
     for k in range(centre):  # heading marker
-        yy, xx = y + int(DR[env.h]) * k, x + int(DC[env.h]) * k
+        yy, xx = y + int(DR[state.heading]) * k, x + int(DC[state.heading]) * k
         img[yy - dot : yy + dot, xx - dot : xx + dot] = ROBOT
     return img
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -10,19 +9,25 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from motiongym.envs.sweeper import task
+from motiongym.envs.core import check_int, check_options, zero_terms
+from motiongym.envs.sweeper import sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
-from motiongym.envs.sweeper.measures import INFO_KEYS, reward_terms, step_info
+from motiongym.envs.sweeper.measures import INFO_KEYS, batch_info, measures
+from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.render import draw
+from motiongym.envs.sweeper.state import SweeperState
 from motiongym.envs.sweeper.vector_state import (
     COUNT,
     KNOWN,
     BatchedGrids,
     ObservationPool,
     check_actions,
+    shift_windows,
     spread_info,
 )
-from motiongym.envs.sweeper.world import DC, DR
 
+MAX_NUM_ENVS = 65_536  # about 1 GiB of state and observations on the largest maps
+WINDOW_KEYS = ("sensed", "swept", "known")  # the planes of the kept windows, in order
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
 
 
@@ -30,7 +35,7 @@ class SweeperVectorEnv(VectorEnv):
     """N :class:`~motiongym.envs.sweeper.env.SweeperEnv` worlds in a few NumPy arrays.
 
     Step for step identical to ``gymnasium.vector.SyncVectorEnv`` over N
-    ``gym.make("motiongym/Sweeper-v0", max_episode_steps=...)`` with
+    ``gym.make("motiongym/Sweeper-v0" or "-v1", max_episode_steps=...)`` with
     ``autoreset_mode=AutoresetMode.SAME_STEP``: same observations (a dict of
     ``(N, ...)`` float32 arrays), rewards (float64), ``terminated``,
     ``truncated`` and ``info`` (each key an ``(N,)`` array with its ``_key``
@@ -62,6 +67,15 @@ class SweeperVectorEnv(VectorEnv):
     once. Odometry noise (``heading_noise``, ``slip_noise``) draws from each
     world's generator inside the step and is not batched: a non-zero value
     raises ValueError. Per-environment Python work happens only in resets.
+    ``num_envs`` is an integer in [1, 65536], ``max_episode_steps`` an
+    integer >= 1; the other keywords are the single environment's, checked
+    by :class:`~motiongym.envs.sweeper.params.SweeperParams`.
+
+    ## Actions
+    Exactly what ``action_space.contains`` accepts: a list or an array of
+    shape ``(N,)`` whose dtype casts safely to int64, values 0..2; anything
+    else a ValueError naming the space. ``state(i)`` gives sub-environment
+    ``i``'s :class:`~motiongym.envs.sweeper.state.SweeperState`.
 
     ## Returned observations
     The arrays of a returned observation are never written while anyone
@@ -91,26 +105,25 @@ class SweeperVectorEnv(VectorEnv):
         render_mode: str | None = None,
         **kwargs: Any,
     ) -> None:
-        if int(num_envs) != num_envs or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        if max_episode_steps is None or int(max_episode_steps) < 1:
-            raise ValueError(f"max_episode_steps must be >= 1, got {max_episode_steps!r}")
-        for name in ("heading_noise", "slip_noise"):
-            if kwargs.get(name, 0.0):
-                raise ValueError(
-                    f"{name}={kwargs[name]!r}: odometry noise is not batched in "
-                    "SweeperVectorEnv; use SyncVectorEnv of SweeperEnv for noisy runs"
-                )
+        N = check_int("num_envs", num_envs, 1, MAX_NUM_ENVS)
+        max_episode_steps = check_int("max_episode_steps", max_episode_steps, 1)
         # The single environment validates the keywords and holds the spaces.
         self._single = single = SweeperEnv(render_mode=render_mode, **kwargs)
-        self.num_envs = N = int(num_envs)
-        self.max_episode_steps = int(max_episode_steps)
+        self.params = p = single.params
+        for name in ("heading_noise", "slip_noise"):
+            if getattr(p, name):
+                raise ValueError(
+                    f"{name}={getattr(p, name)!r}: odometry noise is not batched in "
+                    "SweeperVectorEnv; use SyncVectorEnv of SweeperEnv for noisy runs"
+                )
+        self.num_envs = N
+        self.max_episode_steps = max_episode_steps
         self.render_mode = render_mode
         self.single_observation_space = single.observation_space
         self.observation_space = batch_space(single.observation_space, N)
         self.single_action_space = single.action_space
         self.action_space = batch_space(single.action_space, N)
-        self.w, self.R, self.S, self.K = single.w, single.R, single.S, single.K
+        self.w, self.R, self.S, self.K = p.robot_width, p.sensor_range, p.window, p.coarse
         self._grids = BatchedGrids(N, self.w, self.R, self.K, single.fixed)
 
         i64 = np.int64
@@ -128,7 +141,10 @@ class SweeperVectorEnv(VectorEnv):
         self.sw_obs = np.zeros((N, KK), np.float32)  # csw * inv_block, kept current
         self.ob_obs = np.zeros((N, KK), np.float32)  # cob * inv_block, kept current
         S = self.S
-        self.win = np.zeros((N, 2, S, S), np.uint8)  # windows [sensed, swept] (0/1), kept current
+        # v1's lines of sight (None: v0, the see-through window)
+        self._rays = sight.ray_matrix(self.w, self.R) if p.line_of_sight else None
+        planes = 2 if self._rays is None else 3
+        self.win = np.zeros((N, planes, S, S), np.uint8)  # [sensed, swept, known (v1)], current
         self._rngs: list[np.random.Generator | None] = [None] * N
         self._scenarios: list[task.Scenario | None] = [None] * N
         self._paths: list[list[tuple[int, int]]] = [[] for _ in range(N)]
@@ -148,7 +164,7 @@ class SweeperVectorEnv(VectorEnv):
             seeds = list(seed)
             if len(seeds) != N:
                 raise ValueError(f"reset got {len(seeds)} seeds for num_envs={N}")
-        options = dict(options or {})
+        options = check_options(options, {**task.OPTIONS, "reset_mask": lambda _, mask: mask})
         mask = options.pop("reset_mask", None)
         if mask is None:
             idx = np.arange(N)
@@ -163,8 +179,7 @@ class SweeperVectorEnv(VectorEnv):
             idx = np.flatnonzero(mask)
         self._reset_envs(idx, [seeds[i] for i in idx], options or None)
         self._ready = True
-        zeros = np.zeros(len(idx))
-        info = self._info(idx, (zeros, 0.0, zeros), np.zeros(len(idx), bool))
+        info = self._info(idx, zero_terms(task.REWARD_TERMS), np.zeros(len(idx), bool))
         if mask is not None:
             info = spread_info(info, idx, N)
         self._pool.record(None)
@@ -177,7 +192,9 @@ class SweeperVectorEnv(VectorEnv):
         for i, s in zip(idx.tolist(), seeds, strict=True):
             if s is not None or self._rngs[i] is None:
                 self._rngs[i] = seeding.np_random(s)[0]
-            sc = task.sample_scenario(self._rngs[i], single.fixed, single.map_name, self.w, options)
+            sc = task.sample_scenario(
+                self._rngs[i], single.fixed, self.params.map_name, self.w, options
+            )
             scenarios.append(sc)
         shape = np.array([sc.obstacle.shape for sc in scenarios]).max(axis=0)
         if g.ensure(int(shape[0]), int(shape[1])):
@@ -204,6 +221,10 @@ class SweeperVectorEnv(VectorEnv):
             self.csw[i] = 0.0
             np.add.at(self.csw[i], g.block[m, foot], one)
             obst = g.obst[m, win]
+            if self._rays is not None:
+                vis = sight.visible(obst, self._rays)
+                obst = obst & vis
+                self.win[i, 2] = vis.reshape(S, S)
             g.cell[i, win[obst]] |= KNOWN
             seen = g.block[m, win[obst]]
             self.cob[i] = 0.0
@@ -235,14 +256,11 @@ class SweeperVectorEnv(VectorEnv):
         if ok.any():
             moved, count = self._move(fwd[ok], hf[ok], na[ok], changes)
             new[moved] = count
-        single = self._single
-        rewards = reward_terms(
-            new, bump, self.w, single.sweep_reward, single.time_reward, single.bump_reward
-        )
-        reward = rewards[0] + rewards[1] + rewards[2]
-        terminated = self.n_swept >= self.n_reach
+        terms = task.reward_terms(new, bump, self.params)
+        reward = terms["sweep"] + terms["time"] + terms["bump"]
+        terminated = task.is_success(self.n_swept, self.n_reach)
         truncated = self.steps >= self.max_episode_steps
-        info = self._info(slice(None), rewards, bump)
+        info = self._info(slice(None), terms, bump)
         self._pool.record(changes)
         obs = self._observation()
         done = terminated | truncated
@@ -283,53 +301,66 @@ class SweeperVectorEnv(VectorEnv):
             target = env * KK + g.block.ravel()[at_map[ri, 0] + enter[ri, ci]]
             self._count(self.csw, self.sw_obs, env, target)
             changes["sweep"].append(target)
-        # Sense the window's leading edge (the only cells new to it).
-        edge = g.edge_off[hm]  # (M, S)
-        obst = g.obst.ravel()[at_map + edge]
-        state = cell[at_cell + edge]
-        seen = obst & (state < KNOWN)
-        if seen.any():
-            ri, ci = np.nonzero(seen)
-            e = edge[ri, ci]
-            cell[at_cell[ri, 0] + e] = state[ri, ci] | KNOWN
-            blocks = g.block.ravel()[at_map[ri, 0] + e]
-            inside = blocks >= 0
-            env = moved[ri[inside]]
-            target = env * KK + blocks[inside]
-            self._count(self.cob, self.ob_obs, env, target)
-            changes["obst"].append(target)
-        # Observation windows: shift by the move, fill the leading edge and the
-        # entering (now swept) cells; nothing else in a window changes.
-        fill = np.stack([obst, (state & COUNT) != 0], axis=1)  # (M, 2, S)
-        old = self.win[moved]  # (M, 2, S, S)
-        win = np.empty_like(old)
-        bounds = np.searchsorted(hm, np.arange(5))
-        for k in range(4):
-            lo, hi = bounds[k], bounds[k + 1]
-            if lo == hi:
-                continue
-            part, was, f = win[lo:hi], old[lo:hi], fill[lo:hi]
-            if k == 0:  # east: new[i, j] = old[i, j + 1]
-                part[..., :-1] = was[..., 1:]
-                part[..., -1] = f
-            elif k == 1:  # north: new[i, j] = old[i - 1, j]
-                part[..., 1:, :] = was[..., :-1, :]
-                part[..., 0, :] = f
-            elif k == 2:  # west: new[i, j] = old[i, j - 1]
-                part[..., 1:] = was[..., :-1]
-                part[..., 0] = f
-            else:  # south: new[i, j] = old[i + 1, j]
-                part[..., :-1, :] = was[..., 1:, :]
-                part[..., -1, :] = f
-            rr, cc = g.enter_win[k]
-            part[:, 1, rr, cc] = 1
-        self.win[moved] = win
+        if self._rays is not None:
+            self._sense_window(moved, at_map[:, 0], at_cell[:, 0], changes)
+        else:
+            self._sense_edge(moved, hm, at_map, at_cell, changes)
         changes["rows"].append(moved)
         if self.render_mode is not None:
             rows, cols = self.r[moved].tolist(), self.c[moved].tolist()
             for i, r, c in zip(moved.tolist(), rows, cols, strict=True):
                 self._paths[i].append((r, c))
         return moved, new
+
+    def _sense_window(
+        self, moved: np.ndarray, at_map: np.ndarray, at_cell: np.ndarray, changes: dict
+    ) -> None:
+        """v1: sense the whole window of the worlds ``moved`` through lines of sight."""
+        g, S = self._grids, self.S
+        obst = g.obst.ravel()[at_map[:, None] + g.win_off]  # (M, S*S)
+        vis = sight.visible(obst, self._rays)
+        obst &= vis
+        where = at_cell[:, None] + g.win_off
+        state = g.cell.ravel()[where]
+        seen = obst & (state < KNOWN)
+        if seen.any():
+            ri, ci = np.nonzero(seen)
+            cells, maps = where[ri, ci], at_map[ri] + g.win_off[ci]
+            self._file_obstacles(moved[ri], cells, maps, state[ri, ci], changes)
+        M = len(moved)
+        self.win[moved] = np.stack([obst, (state & COUNT) != 0, vis], axis=1).reshape(M, 3, S, S)
+
+    def _sense_edge(
+        self, moved: np.ndarray, hm: np.ndarray, at_map: np.ndarray, at_cell: np.ndarray, changes
+    ) -> None:
+        """v0: sense the window's leading edge (the only cells new to it); shift the windows."""
+        g = self._grids
+        edge = g.edge_off[hm]  # (M, S)
+        obst = g.obst.ravel()[at_map + edge]
+        state = g.cell.ravel()[at_cell + edge]
+        seen = obst & (state < KNOWN)
+        if seen.any():
+            ri, ci = np.nonzero(seen)
+            e = edge[ri, ci]
+            self._file_obstacles(
+                moved[ri], at_cell[ri, 0] + e, at_map[ri, 0] + e, state[ri, ci], changes
+            )
+        fill = np.stack([obst, (state & COUNT) != 0], axis=1)  # (M, 2, S)
+        self.win[moved] = shift_windows(self.win[moved], fill, hm, g.enter_win)
+
+    def _file_obstacles(
+        self, env: np.ndarray, cells: np.ndarray, maps: np.ndarray, state: np.ndarray, changes
+    ) -> None:
+        """Mark sensed obstacles known: flat ``cells`` of ``g.cell`` (previous ``state``),
+        flat ``maps`` of ``g.block``, of worlds ``env``; count them in the coarse maps."""
+        g = self._grids
+        g.cell.ravel()[cells] = state | KNOWN
+        blocks = g.block.ravel()[maps]
+        inside = blocks >= 0
+        env = env[inside]
+        target = env * (self.K * self.K) + blocks[inside]
+        self._count(self.cob, self.ob_obs, env, target)
+        changes["obst"].append(target)
 
     def _count(
         self, counts: np.ndarray, scaled: np.ndarray, env: np.ndarray, target: np.ndarray
@@ -353,8 +384,7 @@ class SweeperVectorEnv(VectorEnv):
             final_info[key], final_info[f"_{key}"] = arr, done.copy()
         self._reset_envs(di, [None] * len(di), None)
         changes["reset"].append(di)
-        zeros = np.zeros(len(di))
-        fresh = self._info(di, (zeros, 0.0, zeros), np.zeros(len(di), bool))
+        fresh = self._info(di, zero_terms(task.REWARD_TERMS), np.zeros(len(di), bool))
         for key in INFO_KEYS:
             info[key][di] = fresh[key]
         for key, value in self._observation(di).items():
@@ -368,27 +398,27 @@ class SweeperVectorEnv(VectorEnv):
         N, SS = self.num_envs, self.S * self.S
         if idx is not None:
             pose = np.stack([self.r[idx], self.c[idx], self.h[idx], self.bump[idx]], axis=1)
-            return {
-                "sensed": self.win[idx, 0].reshape(-1, SS).astype(np.float32),
-                "swept": self.win[idx, 1].reshape(-1, SS).astype(np.float32),
-                "pose": pose.astype(np.float32),
-                "sweep_map": self.sw_obs[idx],
-                "obstacle_map": self.ob_obs[idx],
+            obs = {
+                key: self.win[idx, k].reshape(-1, SS).astype(np.float32)
+                for k, key in enumerate(WINDOW_KEYS[: self.win.shape[1]])
             }
+            obs.update(pose=pose.astype(np.float32), sweep_map=self.sw_obs[idx])
+            obs["obstacle_map"] = self.ob_obs[idx]
+            return obs
         out, missing = self._pool.take()
         pose = out["pose"]
         pose[:, 0], pose[:, 1], pose[:, 2], pose[:, 3] = self.r, self.c, self.h, self.bump
         if missing is None:  # copy whole
-            np.copyto(out["sensed"], self.win[:, 0].reshape(N, SS))
-            np.copyto(out["swept"], self.win[:, 1].reshape(N, SS))
+            for k, key in enumerate(WINDOW_KEYS[: self.win.shape[1]]):
+                np.copyto(out[key], self.win[:, k].reshape(N, SS))
             np.copyto(out["sweep_map"], self.sw_obs)
             np.copyto(out["obstacle_map"], self.ob_obs)
             return dict(out)
         parts = {key: [a for c in missing for a in c[key]] for key in missing[0]} if missing else {}
         if parts.get("rows") or parts.get("reset"):
             rows = np.concatenate(parts["rows"] + parts["reset"])
-            out["sensed"][rows] = self.win[rows, 0].reshape(-1, SS)
-            out["swept"][rows] = self.win[rows, 1].reshape(-1, SS)
+            for k, key in enumerate(WINDOW_KEYS[: self.win.shape[1]]):
+                out[key][rows] = self.win[rows, k].reshape(-1, SS)
         for key, src in (("sweep", self.sw_obs), ("obst", self.ob_obs)):
             dst = out["sweep_map" if key == "sweep" else "obstacle_map"]
             if parts.get(key):
@@ -399,46 +429,62 @@ class SweeperVectorEnv(VectorEnv):
                 dst[rows] = src[rows]
         return dict(out)
 
-    def _info(self, idx: Any, rewards: tuple[Any, float, Any], bump: np.ndarray) -> dict:
-        info = step_info(
-            self.n_swept[idx],
-            self.n_reach[idx],
-            self.n_over[idx],
-            self.travel[idx],
-            self.turns[idx],
-            self.bumps[idx],
-            self.steps[idx],
-            self.w,
-            bump,
-            rewards,
-        )
+    def _info(self, idx: Any, terms: dict[str, Any], bump: np.ndarray) -> dict:
+        counters = (self.n_swept, self.n_reach, self.n_over, self.travel, self.turns)
+        n_swept, n_reach, *rest = (a[idx] for a in (*counters, self.bumps, self.steps))
+        success = task.is_success(n_swept, n_reach)
+        info = batch_info(success, bump, terms, **measures(n_swept, n_reach, *rest, self.w))
         mask = np.ones(len(info["coverage"]), bool)
         for key in INFO_KEYS:
             info[f"_{key}"] = mask.copy()
         return info
 
     # ----------------------------------------------------------------- render
+    def state(self, i: int) -> SweeperState:
+        """Sub-environment ``i``'s state, as the single environment holds it.
+
+        Without odometry noise the believed pose is the true one; sweep counts
+        stop at 2 (the twin stores no more); ``path`` is recorded only when
+        ``render_mode="rgb_array"``.
+        """
+        if not self._ready:
+            raise RuntimeError("call reset() before state()")
+        g, P = self._grids, self.R
+        sc = self._scenarios[i]
+        H, W = sc.obstacle.shape
+        cell = g.cell[i].reshape(g.Hp, g.Wp)[: H + 2 * P, : W + 2 * P]
+        r, c = int(self.r[i]), int(self.c[i])
+        K = self.K
+        return SweeperState(
+            scenario=sc,
+            row=r,
+            col=c,
+            heading=int(self.h[i]),
+            believed_row=r,
+            believed_col=c,
+            y=float(r),
+            x=float(c),
+            heading_error=0.0,
+            sweeps=(cell[P : P + H, P : P + W] & COUNT).astype(np.int32),
+            believed_swept=((cell & COUNT) > 0).astype(np.float32),
+            known_obstacles=(cell & KNOWN) > 0,
+            coarse_swept=self.csw[i].reshape(K, K).copy(),
+            coarse_obstacles=self.cob[i].reshape(K, K).copy(),
+            window=self.win[i, 0].astype(np.float32),
+            visible=None if self._rays is None else self.win[i, 2].astype(np.float32),
+            n_reachable=int(self.n_reach[i]),
+            n_swept=int(self.n_swept[i]),
+            n_overswept=int(self.n_over[i]),
+            turns=int(self.turns[i]),
+            bumps=int(self.bumps[i]),
+            steps=int(self.steps[i]),
+            travel=float(self.travel[i]),
+            bump=bool(self.bump[i]),
+            path=list(self._paths[i]),
+        )
+
     def render(self) -> tuple[np.ndarray, ...] | None:
         if self.render_mode != "rgb_array" or not self._ready:
             return None
-        from motiongym.envs.sweeper.render import draw
-
-        g, P, frames = self._grids, self.R, []
-        for i in range(self.num_envs):
-            H, W = self._scenarios[i].obstacle.shape
-            cnt = (g.cell[i] & COUNT).reshape(g.Hp, g.Wp)[P : P + H, P : P + W]
-            r, c = int(self.r[i]), int(self.c[i])
-            view = SimpleNamespace(
-                scenario=self._scenarios[i],
-                sweeps=cnt,
-                path=self._paths[i],
-                noisy=False,
-                w=self.w,
-                r=r,
-                c=c,
-                br=r,
-                bc=c,
-                h=int(self.h[i]),
-            )
-            frames.append(draw(view, self._single.cell_pixels))
-        return tuple(frames)
+        px = self.params.cell_pixels
+        return tuple(draw(self.state(i), self.w, px) for i in range(self.num_envs))

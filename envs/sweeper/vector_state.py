@@ -25,12 +25,13 @@ from __future__ import annotations
 
 import sys
 from collections import deque
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-from motiongym.envs.sweeper import world
-from motiongym.envs.sweeper.world import DC, DR
+from motiongym.envs.sweeper import occupancy
+from motiongym.envs.sweeper.occupancy import DC, DR
 
 COUNT = np.uint8(3)  # bits of a cell's state holding its sweep count (0, 1, 2 = twice or more)
 KNOWN = np.uint8(4)  # bit of a cell's state: an obstacle the robot has sensed
@@ -105,7 +106,7 @@ class BatchedGrids:
         self.foot_off = ((fy + P) * Wp + fx + P).astype(np.int64)  # (w*w,) footprint
         enter, self.enter_win = [], []
         for k in range(4):  # cells entering the footprint on a move along heading k
-            rr, cc = np.nonzero(world.entering_mask(int(DR[k]), int(DC[k]), w))
+            rr, cc = np.nonzero(occupancy.entering_mask(int(DR[k]), int(DC[k]), w))
             enter.append((rr + P) * Wp + cc + P)  # relative to the new anchor
             self.enter_win.append((rr + P, cc + P))  # where they sit in the (S, S) window
         self.enter_off = np.array(enter, np.int64)  # (4, w)
@@ -174,30 +175,57 @@ class ObservationPool:
 
 
 def check_actions(actions: Any, N: int) -> np.ndarray:
-    """``(N,)`` int actions in {0, 1, 2}; ValueError naming the problem otherwise."""
-    a = np.asarray(actions)
-    if a.shape not in ((N,), (N, 1)):
-        raise ValueError(
-            f"actions must have shape ({N},): one of 0 (forward), 1 (left), 2 (right) "
-            f"per sub-environment; got shape {a.shape}"
-        )
-    a = a.reshape(N)
-    if a.dtype.kind not in "iu":
-        if a.dtype.kind not in "fb":
-            raise ValueError(f"actions must be integers in {{0, 1, 2}}, got dtype {a.dtype}")
-        if a.dtype.kind == "f":
-            if np.isnan(a).any():
-                raise ValueError(f"actions contain NaN at indices {np.flatnonzero(np.isnan(a))}")
-            if (a != np.round(a)).any():
-                raise ValueError("actions must be integers in {0, 1, 2}, got fractional values")
-        a = a.astype(np.int64)
+    """``(N,)`` int64 actions: exactly what ``MultiDiscrete([3] * N).contains`` accepts
+    (a list or an array of shape ``(N,)``, a dtype that casts safely to int64,
+    values 0..2); anything else a ValueError naming the expected space."""
+    a = np.array(actions) if isinstance(actions, Sequence) else actions
+    expected = (
+        f"an integer array of shape ({N},) in MultiDiscrete([3] * {N}): "
+        "0 (forward), 1 (left) or 2 (right) per sub-environment"
+    )
+    if not isinstance(a, np.ndarray) or a.shape != (N,):
+        raise ValueError(f"actions must be {expected}; got shape {np.shape(a)}")
+    if not np.can_cast(a.dtype, np.int64):
+        raise ValueError(f"actions must be {expected}; got dtype {a.dtype}")
     bad = (a < 0) | (a > 2)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"actions must be 0 (forward), 1 (left) or 2 (right); sub-environment {k} got {a[k]}"
-        )
-    return a
+        raise ValueError(f"actions must be {expected}; sub-environment {k} got {a[k]}")
+    return a.astype(np.int64, copy=False)
+
+
+def shift_windows(
+    old: np.ndarray, fill: np.ndarray, heading: np.ndarray, enter_win: list
+) -> np.ndarray:
+    """v0's windows after a one-cell move: ``(M, 2, S, S)`` [sensed, swept].
+
+    ``old`` windows shift by the move along ``heading`` (sorted, ``(M,)``),
+    the leading edge takes ``fill`` ``(M, 2, S)`` and the cells entering the
+    footprint (``enter_win[k]``, window indices) become swept; nothing else
+    in a window changes.
+    """
+    win = np.empty_like(old)
+    bounds = np.searchsorted(heading, np.arange(5))
+    for k in range(4):
+        lo, hi = bounds[k], bounds[k + 1]
+        if lo == hi:
+            continue
+        part, was, f = win[lo:hi], old[lo:hi], fill[lo:hi]
+        if k == 0:  # east: new[i, j] = old[i, j + 1]
+            part[..., :-1] = was[..., 1:]
+            part[..., -1] = f
+        elif k == 1:  # north: new[i, j] = old[i - 1, j]
+            part[..., 1:, :] = was[..., :-1, :]
+            part[..., 0, :] = f
+        elif k == 2:  # west: new[i, j] = old[i, j - 1]
+            part[..., 1:] = was[..., :-1]
+            part[..., 0] = f
+        else:  # south: new[i, j] = old[i + 1, j]
+            part[..., :-1, :] = was[..., 1:, :]
+            part[..., -1, :] = f
+        rr, cc = enter_win[k]
+        part[:, 1, rr, cc] = 1
+    return win
 
 
 def spread_info(info: dict, idx: np.ndarray, N: int) -> dict:

@@ -1,230 +1,247 @@
-"""The sweeper's grid world: pure functions over NumPy arrays.
+"""The sweeper's world: its state and dynamics, the only code that reads or writes the grid.
 
-The world is an occupancy bitmap ``obstacle`` of shape ``(H, W)`` (True: wall
-or obstacle). The robot is a square of side ``w`` cells; its *configuration*
-is the cell ``(r, c)`` of the footprint's top-left corner, so the footprint is
-``obstacle[r:r + w, c:c + w]`` (paper section 4.1: the robot is a square of
-the sweeping width). A configuration is free when its footprint holds no
-obstacle. Headings are indices 0..3: east (+col), north (-row), west (-col),
-south (+row); a left turn adds one, a right turn subtracts one (mod 4).
-
-Everything here is a function of arrays, so that a batched twin of the
-environment can reuse the same definitions.
+:class:`World` holds one :class:`~motiongym.envs.sweeper.state.SweeperState`:
+``reset(scenario)`` places the robot, ``advance(action, rng)`` moves or turns
+it (sweeping and sensing), ``observation()`` and ``action_masks()`` read it.
+The environment (:mod:`motiongym.envs.sweeper.env`) wires it to Gymnasium;
+what a scenario is and what the reward counts live in
+:mod:`motiongym.envs.sweeper.task`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
 
 import numpy as np
-from scipy import ndimage
 
-DR = np.array([0, -1, 0, 1])  # row step per heading (E, N, W, S)
-DC = np.array([1, 0, -1, 0])  # column step per heading
-HEADING_NAMES = ("east", "north", "west", "south")
+from motiongym.envs.sweeper import occupancy, sight
+from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.params import SweeperParams
+from motiongym.envs.sweeper.state import SweeperState
+from motiongym.envs.sweeper.task import Scenario
 
-
-def box_sum(image: np.ndarray, w: int) -> np.ndarray:
-    """Sum of ``image`` over every ``w x w`` window anchored at its top-left cell.
-
-    Returns an ``(H, W)`` int array; windows that leave the image count only
-    the cells inside it (so anchors near the bottom/right edge see fewer cells).
-    """
-    h, wd = image.shape
-    s = np.zeros((h + w + 1, wd + w + 1), dtype=np.int64)
-    s[1 : h + 1, 1 : wd + 1] = np.cumsum(np.cumsum(image, axis=0), axis=1)
-    s[h + 1 :, 1 : wd + 1] = s[h : h + 1, 1 : wd + 1]
-    s[:, wd + 1 :] = s[:, wd : wd + 1]
-    return s[w : w + h, w : w + wd] - s[:h, w : w + wd] - s[w : w + h, :wd] + s[:h, :wd]
+FORWARD, LEFT, RIGHT = 0, 1, 2
+MAX_SLIP = 1.4  # longest forward move under slip noise, cells
 
 
-def config_free(obstacle: np.ndarray, w: int) -> np.ndarray:
-    """``(H, W)`` bool: configurations whose ``w x w`` footprint lies inside and is free."""
-    h, wd = obstacle.shape
-    free = box_sum(obstacle.astype(np.int64), w) == 0
-    free[h - w + 1 :, :] = False
-    free[:, wd - w + 1 :] = False
-    return free
+class World:
+    """One sweeper world (see ``SweeperEnv``'s docstring for the rules)."""
 
+    def __init__(self, params: SweeperParams) -> None:
+        self.params = params
+        self.w, self.R, self.S, self.K = (
+            params.robot_width,
+            params.sensor_range,
+            params.window,
+            params.coarse,
+        )
+        w, S, last = self.w, self.S, self.S - 1
+        # Cells entering the footprint on a one-cell move, per heading: (w,) offsets.
+        self._enter = [
+            np.nonzero(occupancy.entering_mask(int(DR[k]), int(DC[k]), w)) for k in range(4)
+        ]
+        # The sensing window's leading edge per heading, as slices and cell indices.
+        full = np.arange(S)
+        self._edges = [
+            (slice(None), slice(last, S)),
+            (slice(0, 1), slice(None)),
+            (slice(None), slice(0, 1)),
+            (slice(last, S), slice(None)),
+        ]
+        self._edge_cells = [
+            (full, np.array([last])),
+            (np.array([0]), full),
+            (full, np.array([0])),
+            (np.array([last]), full),
+        ]
+        self._rays = sight.ray_matrix(w, self.R) if params.line_of_sight else None
+        self.state: SweeperState | None = None
 
-def footprint_union(configs: np.ndarray, w: int) -> np.ndarray:
-    """``(H, W)`` bool: cells covered by the footprint of any configuration in ``configs``."""
-    # A cell (i, j) is covered by anchors (r, c) with i - w < r <= i, j - w < c <= j.
-    flipped = configs[::-1, ::-1].astype(np.int64)
-    return box_sum(flipped, w)[::-1, ::-1] > 0
+    # ------------------------------------------------------------------ reset
+    def reset(self, scenario: Scenario) -> SweeperState:
+        """Place the robot at the scenario's start; sweep its footprint; sense."""
+        h, wd = scenario.obstacle.shape
+        P, K, w = self.R, self.K, self.w
+        self._obstacle = np.pad(scenario.obstacle, P, constant_values=True)  # padded, bool
+        self._obstacle_f32 = self._obstacle.astype(np.float32)
+        self._block = (-(-h // K), -(-wd // K))  # coarse block, cells
+        self.inv_block = np.float32(1.0 / (self._block[0] * self._block[1]))
+        r, c = scenario.start
+        self.state = s = SweeperState(
+            scenario=scenario,
+            row=r,
+            col=c,
+            heading=scenario.heading,
+            believed_row=r,
+            believed_col=c,
+            y=float(r),
+            x=float(c),
+            heading_error=0.0,
+            sweeps=np.zeros((h, wd), np.int32),
+            believed_swept=np.zeros((h + 2 * P, wd + 2 * P), np.float32),
+            known_obstacles=np.zeros((h + 2 * P, wd + 2 * P), bool),
+            coarse_swept=np.zeros((K, K), np.float32),
+            coarse_obstacles=np.zeros((K, K), np.float32),
+            window=self._obstacle_f32[:0, :0],
+            visible=None,
+            n_reachable=int(scenario.reachable.sum()),
+            path=[(r, c)],
+        )
+        s.sweeps[r : r + w, c : c + w] = 1
+        s.n_swept = w * w
+        self._mark_believed(np.arange(w).repeat(w) + r, np.tile(np.arange(w), w) + c)
+        self._sense()
+        return s
 
+    # ---------------------------------------------------------------- advance
+    def advance(self, action: int, rng: np.random.Generator) -> int:
+        """Apply ``action`` (0 forward, 1 left, 2 right); return the newly swept cells.
 
-def reachable_configs(free: np.ndarray, start: tuple[int, int]) -> np.ndarray:
-    """``(H, W)`` bool: free configurations 4-connected to ``start`` (one-cell moves)."""
-    labels, _ = ndimage.label(free)
-    label = labels[start]
-    if label == 0:
-        return np.zeros_like(free)
-    return labels == label
+        ``rng`` draws the odometry noise (the environment's ``np_random``).
+        """
+        s, p = self.state, self.params
+        s.steps += 1
+        bump, new = False, 0
+        if action == FORWARD:
+            new, bump = self._noisy_forward(rng) if p.noisy else self._forward()
+        else:
+            s.heading = (s.heading + (1 if action == LEFT else -1)) % 4
+            s.turns += 1
+            if p.noisy:
+                s.heading_error += float(rng.normal(0.0, p.heading_noise))
+        if action == FORWARD and not bump:  # a turn or a bump leaves the window unchanged
+            self._sense(None if p.noisy else s.heading)
+        s.bump = bump
+        return new
 
+    def _forward(self) -> tuple[int, bool]:
+        s = self.state
+        h = s.heading
+        nr, nc = s.row + int(DR[h]), s.col + int(DC[h])
+        if not s.scenario.reach_configs[nr, nc]:
+            s.bumps += 1
+            return 0, True
+        rr, cc = self._enter[h]
+        rr, cc = rr + nr, cc + nc
+        new = self._sweep_cells(rr, cc)
+        s.row, s.col = s.believed_row, s.believed_col = nr, nc
+        s.y, s.x = float(nr), float(nc)
+        s.travel += 1.0
+        s.path.append((nr, nc))
+        self._mark_believed(rr, cc)
+        return new, False
 
-def reachable_cells(obstacle: np.ndarray, w: int, start: tuple[int, int]) -> np.ndarray:
-    """``(H, W)`` bool: the cells the robot can sweep from ``start`` (the coverage target)."""
-    return footprint_union(reachable_configs(config_free(obstacle, w), start), w)
+    def _noisy_forward(self, rng: np.random.Generator) -> tuple[int, bool]:
+        s, p, w = self.state, self.params, self.w
+        s.heading_error += float(rng.normal(0.0, p.heading_noise)) if p.heading_noise else 0.0
+        d = 1.0 + (float(rng.normal(0.0, p.slip_noise)) if p.slip_noise else 0.0)
+        d = min(max(d, 0.0), MAX_SLIP)
+        angle = s.heading * math.pi / 2 + s.heading_error
+        ny, nx = s.y - d * math.sin(angle), s.x + d * math.cos(angle)
+        nr, nc = int(round(ny)), int(round(nx))
+        dr, dc = nr - s.row, nc - s.col
+        reach = s.scenario.reach_configs
+        ok = abs(dr) <= 1 and abs(dc) <= 1 and reach[nr, nc]
+        if ok and dr and dc:  # no corner cutting through a blocked configuration
+            ok = bool(reach[s.row + dr, s.col] or reach[s.row, s.col + dc])
+        if not ok:
+            s.bumps += 1
+            return 0, True
+        new = 0
+        if dr or dc:
+            rr, cc = np.nonzero(occupancy.entering_mask(dr, dc, w))
+            new = self._sweep_cells(rr + nr, cc + nc)
+            s.row, s.col = nr, nc
+            s.path.append((nr, nc))
+        s.y, s.x = ny, nx
+        s.travel += d
+        h, wd = s.scenario.obstacle.shape
+        s.believed_row = min(max(s.believed_row + int(DR[s.heading]), 0), h - w)
+        s.believed_col = min(max(s.believed_col + int(DC[s.heading]), 0), wd - w)
+        rr, cc = self._enter[s.heading]
+        self._mark_believed(rr + s.believed_row, cc + s.believed_col)
+        return new, False
 
+    def _sweep_cells(self, rr: np.ndarray, cc: np.ndarray) -> int:
+        """Sweep the true cells ``(rr, cc)``; return how many were never swept before."""
+        s = self.state
+        before = s.sweeps[rr, cc]
+        s.sweeps[rr, cc] = before + 1
+        new = int(np.count_nonzero(before == 0))
+        s.n_swept += new
+        s.n_overswept += int(np.count_nonzero(before == 1))
+        return new
 
-def is_closed(obstacle: np.ndarray) -> bool:
-    """True when no free cell lies on the map's border (the area is closed)."""
-    border = np.concatenate([obstacle[0], obstacle[-1], obstacle[:, 0], obstacle[:, -1]])
-    return bool(border.all())
+    def _mark_believed(self, rr: np.ndarray, cc: np.ndarray) -> None:
+        """Mark cells swept in the robot's own (believed) sweep map and its coarse copy."""
+        s, P = self.state, self.R
+        fresh = s.believed_swept[rr + P, cc + P] == 0
+        if fresh.any():
+            rr, cc = rr[fresh], cc[fresh]
+            s.believed_swept[rr + P, cc + P] = 1.0
+            counts, (bh, bw) = s.coarse_swept, self._block
+            for r, c in zip(rr.tolist(), cc.tolist(), strict=True):
+                counts[r // bh, c // bw] += 1.0
 
+    def _sense(self, heading: int | None = None) -> None:
+        """Read the obstacle window at the true pose; file it at the believed pose.
 
-def entering_mask(dr: int, dc: int, w: int) -> np.ndarray:
-    """``(w, w)`` bool: cells of the new footprint that were not under the old one.
+        ``heading``: the window just moved one cell that way with the believed
+        pose equal to the true one, so only its leading edge can hold news
+        (v0; line of sight can reveal cells anywhere in the window).
+        """
+        s, R, S = self.state, self.R, self.S
+        r0, c0 = s.row, s.col  # the window's top-left, padded coordinates
+        s.window = self._obstacle_f32[r0 : r0 + S, c0 : c0 + S]
+        win = self._obstacle[r0 : r0 + S, c0 : c0 + S]
+        if self._rays is not None:  # v1: only what a line from the footprint reaches
+            vis = sight.visible(win.ravel(), self._rays).reshape(S, S)
+            s.visible = vis.astype(np.float32)
+            win = win & vis
+            s.window = win.astype(np.float32)
+            heading = None
+        br, bc = s.believed_row, s.believed_col
+        known = s.known_obstacles[br : br + S, bc : bc + S]
+        if heading is not None:
+            edge = self._edges[heading]
+            win, known = win[edge], known[edge]
+        fresh = win & ~known
+        if fresh.any():
+            known |= fresh
+            rr, cc = np.nonzero(fresh)
+            if heading is not None:
+                er, ec = self._edge_cells[heading]
+                rr, cc = er[rr], ec[cc]
+            rr, cc = rr + br - R, cc + bc - R
+            h, wd = s.scenario.obstacle.shape
+            inside = (rr >= 0) & (rr < h) & (cc >= 0) & (cc < wd)
+            bh, bw = self._block
+            np.add.at(s.coarse_obstacles, (rr[inside] // bh, cc[inside] // bw), 1.0)
 
-    The robot moved by ``(dr, dc)`` cells; entry ``[i, j]`` refers to the new
-    footprint's cell ``(r + i, c + j)``.
-    """
-    i = np.arange(w)[:, None] + dr
-    j = np.arange(w)[None, :] + dc
-    return ~((i >= 0) & (i < w) & (j >= 0) & (j < w))
+    # ---------------------------------------------------------------- readers
+    def observation(self) -> dict[str, np.ndarray]:
+        """The observation (see ``SweeperEnv``'s table), fresh arrays."""
+        s, S = self.state, self.S
+        br, bc = s.believed_row, s.believed_col
+        obs = {
+            "sensed": s.window.flatten(),
+            "swept": s.believed_swept[br : br + S, bc : bc + S].flatten(),
+            "pose": np.array([br, bc, s.heading, float(s.bump)], np.float32),
+            "sweep_map": (s.coarse_swept * self.inv_block).ravel(),
+            "obstacle_map": (s.coarse_obstacles * self.inv_block).ravel(),
+        }
+        if s.visible is not None:
+            obs["known"] = s.visible.flatten()
+        return obs
 
-
-@dataclass(frozen=True)
-class SmartDfsBound:
-    """The exploration bound on one map at robot scale (see :func:`smartdfs_bound`)."""
-
-    cells: int  # C: cells of the robot-scale polygon
-    edges: int  # E: their boundary edges
-    holes: int  # H: obstacles the robot can travel round
-    area: int  # reachable cells of the map
-    w: int  # robot width, cells (a step is w cells)
-
-    @property
-    def simple_steps(self) -> float:
-        """SmartDFS's bound for a polygon without holes, ``C + E/2 - 3`` steps."""
-        return self.cells + self.edges / 2.0 - 3.0
-
-    @property
-    def steps(self) -> float:
-        """The bound that applies, in steps: ``C + E/2 + 3H - 2`` around ``H > 0`` obstacles."""
-        if not self.holes:
-            return self.simple_steps
-        return self.cells + self.edges / 2.0 + 3.0 * self.holes - 2.0
-
-    @property
-    def ratio(self) -> float:
-        """``w * steps`` over the lower bound ``area / w``."""
-        return self._over_lower_bound(self.steps)
-
-    @property
-    def simple_ratio(self) -> float:
-        """The same with the no-hole formula ``C + E/2 - 3`` (stricter on a map with holes)."""
-        return self._over_lower_bound(self.simple_steps)
-
-    def _over_lower_bound(self, steps: float) -> float:
-        return self.w * self.w * steps / self.area if self.area else float("inf")
-
-
-def robot_scale_cells(
-    reachable: np.ndarray, w: int, anchor: tuple[int, int] = (0, 0)
-) -> tuple[int, int]:
-    """``(C, E)`` of the reachable area seen as a grid polygon of ``w x w`` cells.
-
-    The map is cut into ``w x w`` blocks, one of them at ``anchor`` (the
-    robot's start configuration: the grid the robot itself would explore
-    in steps of ``w``). A *cell* is a 4-connected piece of the reachable
-    cells inside one block: a block split by a wall thinner than ``w``
-    holds one cell on each side. Two cells are neighbours when their
-    pieces touch across the common side of their blocks; ``E`` counts the
-    sides of cells with no neighbour across. (Counting a block once however
-    its reachable cells lie joins rooms across every wall thinner than the
-    robot: the maze became its empty bounding square, E = its perimeter.)
-    """
-    top, left = (-anchor[0]) % w, (-anchor[1]) % w
-    h, wd = reachable.shape
-    hb, wb = -(-(h + top) // w), -(-(wd + left) // w)
-    grid = np.zeros((hb * w, wb * w), dtype=bool)
-    grid[top : top + h, left : left + wd] = reachable
-    # blocks spread apart by one empty row and column, so no piece spans two blocks
-    apart = np.zeros((hb, w + 1, wb, w + 1), dtype=bool)
-    apart[:, :w, :, :w] = grid.reshape(hb, w, wb, w)
-    labels, c_count = ndimage.label(apart.reshape(hb * (w + 1), wb * (w + 1)))
-    labels = labels.reshape(hb, w + 1, wb, w + 1)[:, :w, :, :w].reshape(hb * w, wb * w)
-    has_neighbour = np.zeros((c_count + 1, 4), dtype=bool)  # per cell: E, N, W, S
-    west, east = labels[:, w - 1 : -1 : w], labels[:, w::w]  # across vertical block sides
-    touch = (west > 0) & (east > 0)
-    has_neighbour[west[touch], 0] = has_neighbour[east[touch], 2] = True
-    north, south = labels[w - 1 : -1 : w, :], labels[w::w, :]  # across horizontal sides
-    touch = (north > 0) & (south > 0)
-    has_neighbour[south[touch], 1] = has_neighbour[north[touch], 3] = True
-    return c_count, int(4 * c_count - has_neighbour[1:].sum())
-
-
-def obstacle_count(reachable: np.ndarray) -> int:
-    """Obstacles the robot can travel round: bounded 8-connected pieces of unreachable cells."""
-    _, pieces = ndimage.label(np.pad(~reachable, 1, constant_values=True), np.ones((3, 3)))
-    return pieces - 1  # the piece holding the map's frame is the outside
-
-
-def smartdfs_bound(
-    reachable: np.ndarray, w: int, anchor: tuple[int, int] = (0, 0)
-) -> SmartDfsBound:
-    """The travel bound of Icking, Kamphans and Langetepe's online exploration, at robot scale.
-
-    "Exploring grid polygons online" (Icking, Kamphans, Langetepe 2005,
-    arXiv:1012.5240): a robot that senses its four neighbour cells explores
-    a grid polygon of ``C`` cells and ``E`` boundary edges and returns to
-    its start in at most ``C + E/2 - 3`` steps when the polygon has no
-    holes (SmartDFS), and in at most ``C + E/2 + 3H + W_cw - 2`` steps
-    around ``H`` obstacles (``W_cw >= 0`` measures the polygon's
-    sinuosity). ``C`` and ``E`` come from :func:`robot_scale_cells`, ``H``
-    from :func:`obstacle_count`. Our choice: with obstacles the bound drops
-    ``W_cw`` (which needs the strategy's own tour to measure), so it is
-    never above the theorem's; ``simple_ratio`` keeps the no-hole formula
-    on every map, a stricter yardstick still. Both tours return to the
-    start, which a sweep need not do. A step is ``w`` cells; ratios are
-    over the lower bound ``area / w``.
-    """
-    c_count, edges = robot_scale_cells(reachable, w, anchor)
-    return SmartDfsBound(c_count, edges, obstacle_count(reachable), int(reachable.sum()), w)
-
-
-def bfs_distance(free: np.ndarray, start: tuple[int, int]) -> np.ndarray:
-    """``(H, W)`` int: 4-connected step distance from ``start`` over ``free`` (-1: unreached).
-
-    A wavefront expansion, one NumPy dilation per distance level.
-    """
-    dist = np.full(free.shape, -1, dtype=np.int64)
-    if not free[start]:
-        return dist
-    dist[start] = 0
-    frontier = np.zeros_like(free)
-    frontier[start] = True
-    seen = frontier.copy()
-    level = 0
-    while frontier.any():
-        level += 1
-        grown = np.zeros_like(frontier)
-        grown[1:, :] |= frontier[:-1, :]
-        grown[:-1, :] |= frontier[1:, :]
-        grown[:, 1:] |= frontier[:, :-1]
-        grown[:, :-1] |= frontier[:, 1:]
-        frontier = grown & free & ~seen
-        seen |= frontier
-        dist[frontier] = level
-    return dist
-
-
-def descend(dist: np.ndarray, goal: tuple[int, int]) -> list[tuple[int, int]]:
-    """The path of cells from the BFS source to ``goal`` (source excluded) down ``dist``."""
-    if dist[goal] < 0:
-        raise ValueError(f"goal {goal} is not reachable")
-    path = [goal]
-    r, c = goal
-    h, wd = dist.shape
-    while dist[r, c] > 0:
-        d = dist[r, c]
-        for k in range(4):
-            rr, cc = r - DR[k], c - DC[k]
-            if 0 <= rr < h and 0 <= cc < wd and dist[rr, cc] == d - 1:
-                r, c = int(rr), int(cc)
-                break
-        path.append((r, c))
-    path.pop()  # the source
-    return path[::-1]
+    def action_masks(self) -> np.ndarray:
+        """(3,) bool: forward allowed unless the sensed row ahead holds an obstacle."""
+        s, R, w = self.state, self.R, self.w
+        win = s.window
+        ahead = (
+            win[R : R + w, R + w],  # east: the column right of the footprint
+            win[R - 1, R : R + w],  # north: the row above it
+            win[R : R + w, R - 1],  # west
+            win[R + w, R : R + w],  # south
+        )[s.heading]
+        return np.array([not ahead.any(), True, True])

@@ -103,7 +103,21 @@ def test_bad_keywords_are_named(space):
         SweeperEgocentric(space, map_shape=(30, 40), channels=(4, 4, 4, 4, 4))
 
 
-def test_a_config_naming_it_trains_and_the_model_evaluates(tmp_path):
+def test_v1_known_window_is_a_third_window_channel():
+    space = gym.make("motiongym/Sweeper-v1").observation_space
+    env = gym.make("motiongym/Sweeper-v1")
+    observations = [env.reset(seed=seed)[0] for seed in range(3)]
+    batch = {key: torch.as_tensor(np.stack([o[key] for o in observations])) for key in space}
+    extractor = SweeperEgocentric(space, map_shape=(30, 40), features_dim=24)
+    windows = extractor.egocentric_windows(batch)
+    assert windows.shape == (3, 3, S * S)
+    assert torch.equal(windows[:, 2].sum(1), batch["known"].sum(1))  # a permutation of it
+    unknown = dict(batch, known=torch.zeros_like(batch["known"]))
+    assert not torch.equal(extractor(batch), extractor(unknown))  # the features read it
+
+
+@pytest.mark.parametrize("env_id", [SWEEPER, "motiongym/Sweeper-v1"])
+def test_a_config_naming_it_trains_and_the_model_evaluates(tmp_path, env_id):
     config = tmp_path / "ego.yml"
     config.write_text(
         "maskableppo:\n  n_envs: 2\n  n_timesteps: 256\n  policy: MultiInputPolicy\n"
@@ -112,11 +126,11 @@ def test_a_config_naming_it_trains_and_the_model_evaluates(tmp_path):
         "    net_arch: [16]\n  n_steps: 64\n  batch_size: 64\n  eval_freq: 128\n"
         "  n_eval_episodes: 1\n  env_kwargs: {max_episode_steps: 50}\n"
     )
-    run_dir = train(SWEEPER, "maskableppo", config_path=config, out_root=tmp_path, progress=False)
-    env = make_env(SWEEPER, {"max_episode_steps": 50})
-    predictor = load_predictor(str(run_dir), SWEEPER, env)
+    run_dir = train(env_id, "maskableppo", config_path=config, out_root=tmp_path, progress=False)
+    env = make_env(env_id, {"max_episode_steps": 50})
+    predictor = load_predictor(str(run_dir), env_id, env)
     assert isinstance(predictor.model.policy.features_extractor, SweeperEgocentric)
-    assert evaluate(env, predictor, [3], SWEEPER, "ego", progress=False).episodes[0]["length"] == 50
+    assert evaluate(env, predictor, [3], env_id, "ego", progress=False).episodes[0]["length"] == 50
 
 
 def test_an_unknown_extractor_name_lists_the_known_ones(tmp_path):

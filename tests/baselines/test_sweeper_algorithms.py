@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from motiongym.baselines.sweeper import cwa, psa, quadtree
-from motiongym.envs.sweeper import generator, maps, world
+from motiongym.envs.sweeper import generator, maps, occupancy
 
 
 def test_quadtree_leaves_tile_the_free_cells_exactly() -> None:
-    free = world.config_free(maps.shipped_map("apartment"), 3)
+    free = occupancy.config_free(maps.shipped_map("apartment"), 3)
     leaves, label = quadtree.decompose(free)
     covered = np.zeros_like(free)
     for r, c, s in leaves:
@@ -24,14 +24,14 @@ def test_quadtree_leaves_tile_the_free_cells_exactly() -> None:
 
 @pytest.mark.parametrize("name", ["room", "apartment", "maze"])
 def test_quadtree_path_valid_complete_and_near_shortest(name: str) -> None:
-    free = world.config_free(maps.shipped_map(name), 3)
+    free = occupancy.config_free(maps.shipped_map(name), 3)
     cells = np.argwhere(free)
     rng = np.random.default_rng(1)
     total_q = total_bfs = 0
     for _ in range(30):
         a = tuple(int(v) for v in cells[rng.integers(len(cells))])
         b = tuple(int(v) for v in cells[rng.integers(len(cells))])
-        dist = world.bfs_distance(free, a)
+        dist = occupancy.bfs_distance(free, a)
         path = quadtree.plan(free, a, b)
         if dist[b] < 0:
             assert path is None
@@ -46,7 +46,7 @@ def test_quadtree_path_valid_complete_and_near_shortest(name: str) -> None:
 
 def test_best_path_is_shortest_and_sweeps_the_leftover_strip() -> None:
     grid = generator.empty_room(12, 12)
-    free = world.config_free(grid, 3)
+    free = occupancy.config_free(grid, 3)
     todo = np.zeros(grid.shape, bool)
     todo[1, 8:11] = True  # a leftover strip along the north wall, to the east
     gains = psa.entering_gains(todo, 3)
@@ -76,7 +76,7 @@ def test_entering_gains_count_the_cells_a_move_sweeps() -> None:
 def test_quadtree_no_path_between_separate_rooms() -> None:
     grid = generator.empty_room(10, 21)
     grid[:, 10] = True
-    free = world.config_free(grid, 3)
+    free = occupancy.config_free(grid, 3)
     assert quadtree.plan(free, (1, 1), (1, 12)) is None
 
 
@@ -186,11 +186,11 @@ def test_cwa_leftovers_and_nearest_cover() -> None:
     occ = grid.astype(np.int8)
     swept = np.zeros_like(grid)
     swept[1:4, 1:8] = True  # one lane swept: rows 4-5 remain
-    free = world.config_free(grid, 3)
-    reach = world.reachable_configs(free, (1, 1))
+    free = occupancy.config_free(grid, 3)
+    reach = occupancy.reachable_configs(free, (1, 1))
     left = cwa.leftovers(occ, swept, reach, 3)
     assert left.sum() == 2 * 7 and left[4:6, 1:8].all()
-    dist = world.bfs_distance(free, (1, 1))
+    dist = occupancy.bfs_distance(free, (1, 1))
     assert cwa.nearest_cover(dist, np.argwhere(left), 3) == (2, 1)  # one step south
 
 

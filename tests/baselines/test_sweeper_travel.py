@@ -1,7 +1,7 @@
 """Travel of the sweeper's PSA + CWA against the lower bound and the exploration bound.
 
 The issue asks for travel / (area / W) below the ratio that SmartDFS's
-bound gives for each map. :func:`motiongym.envs.sweeper.world.smartdfs_bound`
+bound gives for each map. :func:`motiongym.envs.sweeper.occupancy.smartdfs_bound`
 gives the bound of the online grid exploration that applies to the map
 (``C + E/2 - 3`` without holes, ``C + E/2 + 3H - 2`` around H obstacles)
 and the no-hole formula on every map. Measured (seeds 0-19 room and maze,
@@ -22,7 +22,7 @@ import pytest
 import motiongym  # noqa: F401
 from motiongym.baselines.registry import make_policy
 from motiongym.baselines.sweeper.run import run_episode, sweep
-from motiongym.envs.sweeper import world
+from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.generator import empty_room
 
 ENV_ID = "motiongym/Sweeper-v0"
@@ -39,7 +39,7 @@ def _ratios(map_name: str, seeds: range) -> tuple[np.ndarray, np.ndarray]:
         assert info["is_success"], (map_name, seed)
         sc = env.unwrapped.scenario
         ours.append(info["travel_ratio"])
-        bound.append(world.smartdfs_bound(sc.reachable, 3, sc.start).ratio)
+        bound.append(occupancy.smartdfs_bound(sc.reachable, 3, sc.start).ratio)
     return np.array(ours), np.array(bound)
 
 
@@ -47,7 +47,7 @@ def test_smartdfs_ratio_on_a_block_aligned_room() -> None:
     # a 12 x 12 free square, W = 3: 4 x 4 blocks, C = 16, E = 16 boundary edges
     reachable = np.zeros((14, 14), bool)
     reachable[1:13, 1:13] = True
-    bound = world.smartdfs_bound(reachable, 3, (1, 1))
+    bound = occupancy.smartdfs_bound(reachable, 3, (1, 1))
     assert (bound.cells, bound.edges) == (16, 16)
     # C + E/2 - 3 = 21 steps of 3 cells = 63 cells, lower bound 144 / 3 = 48 cells
     assert bound.ratio == pytest.approx(63 / 48)

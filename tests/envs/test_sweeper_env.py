@@ -34,7 +34,7 @@ def test_gymnasium_and_sb3_check_env(kwargs: dict) -> None:
 def test_make_without_import_and_spec_defaults() -> None:
     env = gym.make("motiongym:motiongym/Sweeper-v0")
     assert env.spec.max_episode_steps == 20_000
-    assert env.unwrapped.w == 3 and env.unwrapped.map_name == "room"
+    assert env.unwrapped.params.robot_width == 3 and env.unwrapped.params.map_name == "room"
 
 
 def _run(env: gym.Env, actions, seed: int = 3, options=None):
@@ -74,17 +74,17 @@ def test_reward_terms_sum_and_info_keys() -> None:
 
 
 def test_forward_sweeps_a_new_row_and_bump_stays() -> None:
-    env = SweeperEnv(grid=empty_room(8, 10), robot_width=3, time_reward=-0.1)
+    env = SweeperEnv(grid=empty_room(8, 10), robot_width=3, time=-0.1)
     obs, info = env.reset(seed=0, options={"start": (1, 1), "heading": 0})
     assert info["coverage"] == pytest.approx(9 / 48)
     obs, r, _, _, info = env.step(FORWARD)
-    assert (env.r, env.c) == (1, 2) and info["reward_sweep"] == pytest.approx(1.0)
+    assert (env.state.row, env.state.col) == (1, 2) and info["reward_sweep"] == pytest.approx(1.0)
     assert r == pytest.approx(0.9) and info["travel"] == 1.0
     for _ in range(4):
         env.step(FORWARD)
-    assert (env.r, env.c) == (1, 6)  # the footprint touches the east wall
+    assert (env.state.row, env.state.col) == (1, 6)  # the footprint touches the east wall
     obs, r, _, _, info = env.step(FORWARD)
-    assert (env.r, env.c) == (1, 6) and info["cost"] == 1.0 and info["bumps"] == 1
+    assert (env.state.row, env.state.col) == (1, 6) and info["cost"] == 1.0 and info["bumps"] == 1
     assert obs["pose"][3] == 1.0 and r == pytest.approx(-1.1)
     obs, _, _, _, info = env.step(LEFT)
     assert obs["pose"][2] == 1 and info["turns"] == 1
@@ -130,35 +130,96 @@ def test_reset_options_and_errors() -> None:
     env = gym.make(ENV_ID)
     obs, _ = env.reset(seed=0, options={"start": (5, 5), "heading": 2})
     assert obs["pose"][:3].tolist() == [5, 5, 2]
-    with pytest.raises(ValueError, match="not a free configuration"):
+    with pytest.raises(ValueError, match="must be a free configuration"):
         env.reset(options={"start": (0, 0)})
-    with pytest.raises(ValueError, match="heading"):
-        env.reset(options={"heading": 7})
-    with pytest.raises(ValueError, match="unknown reset options"):
-        env.reset(options={"goal": 1})
-    with pytest.raises(ValueError, match="unknown map_name"):
-        SweeperEnv(map_name="castle")
+    bad_options = [
+        ({"heading": 7}, r"options\['heading'\] must be an integer in \[0, 3\], got 7"),
+        ({"heading": 1.0}, r"options\['heading'\] must be an integer"),
+        ({"start": (5.5, 5)}, r"options\['start'\]\[0\] must be an integer >= 0, got 5.5"),
+        ({"start": (-1, 5)}, r"options\['start'\]\[0\] must be an integer >= 0, got -1"),
+        ({"start": "55"}, r"options\['start'\] must be \(row, col\)"),
+        ({"start": (1, 2, 3)}, r"options\['start'\] must be \(row, col\)"),
+        ({"goal": 1}, "unknown reset option"),
+        ("notadict", "options must be None or a dict, got 'notadict'"),
+    ]
+    for options, match in bad_options:
+        with pytest.raises(ValueError, match=match):
+            env.reset(options=options)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"map_name": "castle"}, "map_name must be one of 'room'"),
+        ({"robot_width": 0}, r"robot_width must be an integer in \[1, 10\], got 0"),
+        ({"robot_width": 5.5}, "robot_width must be an integer"),
+        ({"sensor_range": 10**5}, r"sensor_range must be an integer in \[1, 16\]"),
+        ({"coarse": 10**4}, r"coarse must be an integer in \[1, 64\], got 10000"),
+        ({"coarse": True}, "coarse must be an integer"),
+        ({"heading_noise": float("nan")}, "heading_noise must be a finite number"),
+        ({"slip_noise": -0.1}, "slip_noise must be a finite number in"),
+        ({"sweep": float("inf")}, "sweep must be a finite number"),
+        ({"time": "fast"}, "time must be a finite number"),
+        ({"bump": float("nan")}, "bump must be a finite number"),
+        ({"cell_pixels": 0}, "cell_pixels must be an integer in"),
+        ({"line_of_sight": "yes"}, "line_of_sight must be True or False, got 'yes'"),
+        ({"map_file": 3}, "map_file must be None or a path, got 3"),
+        ({"grid": [["a", "b"]]}, r"grid must be an array of shape \(n, n\)"),
+        ({"grid": np.full((5, 5), np.nan)}, r"grid must be finite"),
+        ({"grid": np.zeros((3, 3, 3))}, r"grid must be an array of shape \(n, n\)"),
+        ({"grid": np.ones((300, 8))}, "exceeds the largest side 256"),
+        ({"colour": "red"}, "unknown keyword argument.* colour"),
+        ({"render_mode": "human"}, "render_mode must be one of None, 'rgb_array'"),
+    ],
+)
+def test_bad_keyword_arguments_name_the_argument(kwargs, match) -> None:
+    with pytest.raises(ValueError, match=match):
+        SweeperEnv(**kwargs)
+    if "render_mode" not in kwargs:  # gym.make wraps "human" around "rgb_array"
+        with pytest.raises(ValueError, match=match):
+            gym.make(ENV_ID, **kwargs)
+
+
+def test_map_errors_reach_the_user() -> None:
     with pytest.raises(FileNotFoundError):
         SweeperEnv(map_file="/nonexistent/map.txt")
-    with pytest.raises(ValueError, match="robot_width"):
-        SweeperEnv(robot_width=0)
-    with pytest.raises(TypeError):
-        gym.make(ENV_ID, colour="red")
 
 
-@pytest.mark.parametrize("action", [np.array([0, 1]), np.nan, 3, -1, 1.5])
+@pytest.mark.parametrize(
+    "action",
+    [np.array([0, 1]), np.nan, 3, -1, 1.5, 1.0, "1", np.array([[1]]), np.array([0]), 1j, None],
+)
 def test_bad_actions_raise(action) -> None:
     env = SweeperEnv()
     env.reset(seed=0)
-    with pytest.raises(ValueError, match="action"):
+    with pytest.raises(ValueError, match=r"action must be in Discrete\(3\)"):
         env.step(action)
 
 
-def test_accepts_numpy_actions() -> None:
+def test_accepts_what_the_action_space_contains() -> None:
     env = SweeperEnv()
     env.reset(seed=0)
-    for a in (np.int64(1), np.array(2), np.array([0]), 0.0):
+    for a in (np.int64(1), np.array(2), np.uint8(0), 2, True):
+        assert env.action_space.contains(a)
         env.step(a)
+
+
+def test_step_and_render_before_reset_raise() -> None:
+    env = SweeperEnv(render_mode="rgb_array")
+    with pytest.raises(RuntimeError, match=r"call reset\(\) before step\(\)"):
+        env.step(0)
+    with pytest.raises(RuntimeError, match=r"call reset\(\) before render\(\)"):
+        env.render()
+    env.reset(seed=0)
+    assert env.render().shape == (30 * 8, 40 * 8, 3)
+
+
+def test_policies_build_the_same_parameters() -> None:
+    from motiongym.envs.sweeper.params import SweeperParams
+
+    kwargs = {"map_name": "maze", "robot_width": 2, "max_episode_steps": 5}
+    assert SweeperParams.from_kwargs(kwargs).sensor_range == 2  # the env's default rule
+    assert SweeperParams.from_kwargs({}).robot_width == SweeperEnv().params.robot_width
 
 
 def test_odometry_noise_drifts_belief_but_counts_true_coverage() -> None:
@@ -168,15 +229,18 @@ def test_odometry_noise_drifts_belief_but_counts_true_coverage() -> None:
     drift = 0
     for _ in range(600):
         env.step(int(rng.choice(3, p=[0.8, 0.1, 0.1])))
-        drift = max(drift, abs(env.r - env.br) + abs(env.c - env.bc))
+        s = env.state
+        drift = max(drift, abs(s.row - s.believed_row) + abs(s.col - s.believed_col))
     assert drift >= 2
-    assert env.n_swept == int((env.sweeps > 0).sum())  # coverage from the true sweeps
-    assert ((env.sweeps > 0) <= env.scenario.reachable).all()
+    s = env.state
+    assert s.n_swept == int((s.sweeps > 0).sum())  # coverage from the true sweeps
+    assert ((s.sweeps > 0) <= s.scenario.reachable).all()
     quiet = SweeperEnv(map_name="room")
     quiet.reset(seed=4)
     for _ in range(300):
         quiet.step(int(rng.choice(3)))
-        assert (quiet.r, quiet.c) == (quiet.br, quiet.bc)
+        s = quiet.state
+        assert (s.row, s.col) == (s.believed_row, s.believed_col)
 
 
 def test_pickle_render_and_procedural_maps() -> None:

@@ -67,13 +67,18 @@ def compare(num_envs: int, max_steps: int, n_steps: int, seed: int, **kwargs) ->
         ({"map_name": "room"}, 3, 70, 600),
         ({"map_name": "maze", "robot_width": 2, "coarse": 8}, 2, 90, 400),
         (
-            {"map_name": "apartment", "robot_width": 4, "sensor_range": 1, "sweep_reward": 2.0},
+            {"map_name": "apartment", "robot_width": 4, "sensor_range": 1, "sweep": 2.0},
             2,
             80,
             400,
         ),
         ({"map_name": "random-room"}, 5, 60, 300),  # maps of several shapes: the layout grows
         ({"map_name": "random"}, 3, 50, 300),
+        # v1 (line of sight): the whole window is sensed again after every move
+        ({"grid": empty_room(8, 11), "line_of_sight": True}, 4, 150, 800),
+        ({"map_name": "room", "line_of_sight": True}, 3, 70, 600),
+        ({"map_name": "maze", "robot_width": 2, "coarse": 8, "line_of_sight": True}, 2, 90, 400),
+        ({"map_name": "random", "sensor_range": 5, "line_of_sight": True}, 3, 50, 300),
     ],
 )
 def test_step_for_step_equal_to_sync_vector_env(kwargs, num_envs, max_steps, n_steps) -> None:
@@ -212,7 +217,7 @@ def test_reset_options_reach_every_sub_environment() -> None:
     assert (got[0]["pose"][:, :3] == [2, 3, 1]).all()
     for a in np.random.default_rng(0).integers(0, 3, size=(40, 3)):  # autoresets: random again
         assert_same(env.step(a), sync.step(a))
-    with pytest.raises(ValueError, match="unknown reset options"):
+    with pytest.raises(ValueError, match="unknown reset option"):
         env.reset(options={"goal": 1})
 
 
@@ -223,15 +228,28 @@ def test_reset_options_reach_every_sub_environment() -> None:
         (np.zeros((4, 2), np.int64), "shape"),
         (np.array([0, 1, 3, 0]), "sub-environment 2 got 3"),
         (np.array([0, -1, 0, 0]), "sub-environment 1 got -1"),
-        (np.array([0.0, np.nan, 1.0, 2.0]), "NaN"),
-        (np.array([0.0, 0.5, 1.0, 2.0]), "integers"),
-        (np.array(["a", "b", "c", "d"]), "integers"),
+        (np.array([0.0, np.nan, 1.0, 2.0]), "got dtype float64"),
+        (np.array([0.0, 0.5, 1.0, 2.0]), "got dtype float64"),
+        (np.array([0.0, 1.0, 1.0, 2.0]), "got dtype float64"),  # as MultiDiscrete.contains
+        (np.array(["a", "b", "c", "d"]), "got dtype <U1"),
+        (np.zeros((4, 1), np.int64), r"shape \(4,\) in MultiDiscrete\(\[3\] \* 4\)"),
+        ("0101", "got shape"),
+        (np.array([0, 1, 2, 2], np.uint64), "got dtype uint64"),
     ],
 )
 def test_bad_actions_raise(actions, match) -> None:
     env = SweeperVectorEnv(num_envs=4)
     env.reset(seed=0)
+    assert not env.action_space.contains(actions)
     with pytest.raises(ValueError, match=match):
+        env.step(actions)
+
+
+def test_accepts_what_the_action_space_contains() -> None:
+    env = SweeperVectorEnv(num_envs=4)
+    env.reset(seed=0)
+    for actions in ([0, 1, 2, 0], np.array([2, 1, 0, 0], np.uint8), np.ones(4, bool)):
+        assert env.action_space.contains(actions)
         env.step(actions)
 
 
@@ -240,10 +258,14 @@ def test_bad_construction_raises() -> None:
         SweeperVectorEnv(num_envs=2, heading_noise=0.1)
     with pytest.raises(ValueError, match="slip_noise"):
         SweeperVectorEnv(num_envs=2, slip_noise=0.1)
-    with pytest.raises(ValueError, match="unknown map_name"):
+    with pytest.raises(ValueError, match="map_name must be one of"):
         SweeperVectorEnv(num_envs=2, map_name="castle")
-    with pytest.raises(ValueError, match="num_envs"):
+    with pytest.raises(ValueError, match=r"num_envs must be an integer in \[1, 65536\], got 0"):
         SweeperVectorEnv(num_envs=0)
+    with pytest.raises(ValueError, match="num_envs must be an integer"):
+        SweeperVectorEnv(num_envs=2.5)
+    with pytest.raises(ValueError, match="max_episode_steps must be an integer >= 1, got None"):
+        SweeperVectorEnv(num_envs=2, max_episode_steps=None)
     with pytest.raises(RuntimeError, match="reset"):
         SweeperVectorEnv(num_envs=2).step(np.zeros(2, np.int64))
 
@@ -301,10 +323,43 @@ def test_make_vec_vector_entry_point() -> None:
         ({"map_name": "maze", "coarse": 1, "sensor_range": 6}, 4, 400),
         ({"map_name": "random-maze", "robot_width": 2}, 6, 200),
         ({"map_name": "random-apartment", "robot_width": 5, "sensor_range": 2}, 6, 200),
-        ({"map_name": "random", "time_reward": -0.3, "bump_reward": -2.5}, 8, 150),
+        ({"map_name": "random", "time": -0.3, "bump": -2.5}, 8, 150),
+        ({"map_name": "apartment", "robot_width": 1, "line_of_sight": True}, 4, 400),
+        ({"map_name": "random-apartment", "sensor_range": 6, "line_of_sight": True}, 6, 200),
     ],
 )
 def test_long_runs_equal_to_sync_vector_env(kwargs, num_envs, max_steps) -> None:
     """Edge widths, sensor ranges and coarse resolutions over thousands of steps."""
     _, n_trunc = compare(num_envs, max_steps, 3000, seed=123, **kwargs)
     assert n_trunc > 0
+
+
+@pytest.mark.parametrize("line_of_sight", [False, True])
+def test_state_of_each_sub_environment_equals_the_single_env_state(line_of_sight: bool) -> None:
+    """The vector twin exports the single env's SweeperState (sweep counts stop at 2)."""
+    import dataclasses
+
+    kwargs = {"map_name": "room", "line_of_sight": line_of_sight, "render_mode": "rgb_array"}
+    native = SweeperVectorEnv(num_envs=3, max_episode_steps=10_000, **kwargs)
+    singles = [gym.make(ENV_ID, **kwargs).unwrapped for _ in range(3)]
+    native.reset(seed=9)
+    for i, env in enumerate(singles):
+        env.reset(seed=9 + i)
+    rng = np.random.default_rng(9)
+    for _ in range(400):
+        actions = rng.choice(3, size=3, p=[0.6, 0.2, 0.2])
+        native.step(actions)
+        for env, a in zip(singles, actions.tolist(), strict=True):
+            env.step(a)
+    for i, env in enumerate(singles):
+        got, want = native.state(i), env.state
+        for field in dataclasses.fields(want):
+            a, b = getattr(got, field.name), getattr(want, field.name)
+            if field.name == "sweeps":
+                b = np.minimum(b, 2)
+            if field.name == "scenario":
+                np.testing.assert_array_equal(a.obstacle, b.obstacle)
+                assert a.start == b.start
+                continue
+            np.testing.assert_array_equal(a, b, err_msg=field.name)
+        assert got.n_overswept > 0 and got.known_obstacles.any()

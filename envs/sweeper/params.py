@@ -1,0 +1,119 @@
+"""The sweeper's parameters: one frozen dataclass built from the environment's keywords.
+
+:class:`SweeperParams` is what ``SweeperEnv(**kwargs)``, its vector twin and
+the scripted policies all build from the same keyword arguments
+(:meth:`SweeperParams.from_kwargs`), so every default is written here once
+and every bad value is refused at construction, never per step.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Mapping
+from typing import Any
+
+from motiongym.envs.core import (
+    ArgumentError,
+    check_bool,
+    check_choice,
+    check_float,
+    check_int,
+    check_shape,
+    params_from_kwargs,
+)
+from motiongym.envs.sweeper import generator, maps
+
+MAP_CHOICES = (*maps.SHIPPED_MAPS, "random", *(f"random-{k}" for k in generator.KINDS))
+MAX_ROBOT_WIDTH = 10  # cells
+MAX_SENSOR_RANGE = 16  # cells beyond the footprint
+MAX_COARSE = 64  # K: the coarse maps hold K * K numbers each
+MAX_CELL_PIXELS = 32  # pixels per cell in a rendered frame (a 256-cell side: 8,192 pixels)
+MAX_NOISE = 1.0  # rad per action (heading), relative std (slip)
+MAX_WEIGHT = 1e6  # largest magnitude of a reward weight
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class SweeperParams:
+    """Every keyword argument of ``SweeperEnv``, checked, with its default.
+
+    ============== ========= ===================================================
+    name           default   allowed (the limits bound memory and time per step)
+    ============== ========= ===================================================
+    map_name       "room"    "room", "apartment", "maze", "random",
+                             "random-room", "random-apartment", "random-maze"
+    map_file       None      a path (str or os.PathLike) to a .txt or .png map;
+                             overrides ``map_name``
+    grid           None      an (H, W) array of bools or finite numbers
+                             (nonzero: obstacle), at most 256 a side;
+                             overrides both
+    robot_width    3         integer cells in [1, 10]
+    sensor_range   None      integer cells in [1, 16] beyond the footprint;
+                             None: ``robot_width``
+    coarse         16        K, integer in [1, 64] (coarse maps of K * K)
+    heading_noise  0.0       rad std per action, finite in [0, 1]
+    slip_noise     0.0       relative std of a move's length, finite in [0, 1]
+    sweep          1.0       weight of the ``sweep`` reward term, finite,
+                             magnitude at most 1e6 (so are the next two)
+    time           -0.05     the ``time`` term (a step cost)
+    bump           -1.0      the ``bump`` term
+    cell_pixels    8         render scale, integer in [1, 32]
+    line_of_sight  False     True or False (True: ``Sweeper-v1``)
+    ============== ========= ===================================================
+
+    Maps are at most 256 cells a side (:data:`maps.MAX_SIDE`), checked when
+    the map is loaded. So the sensing window has at most ``S = 10 + 2 * 16 =
+    42`` cells a side, a step touches at most ``S^2`` cells (and, with line
+    of sight, a product over at most 2.36 M line entries, built once), and a
+    frame has at most ``8,192^2`` pixels.
+    """
+
+    map_name: str = "room"
+    map_file: str | os.PathLike | None = None
+    grid: Any = None
+    robot_width: int = 3  # cells
+    sensor_range: int | None = None  # cells beyond the footprint (None: robot_width)
+    coarse: int = 16  # built-map resolution in the observation
+    heading_noise: float = 0.0  # rad, std per action
+    slip_noise: float = 0.0  # relative std of a forward move's length
+    sweep: float = 1.0  # per fresh lane cell
+    time: float = -0.05  # per step
+    bump: float = -1.0  # per bump
+    cell_pixels: int = 8  # render scale
+    line_of_sight: bool = False  # v1's sensing
+
+    def __post_init__(self) -> None:
+        check_choice("map_name", self.map_name, MAP_CHOICES)
+        if self.map_file is not None and not isinstance(self.map_file, (str, os.PathLike)):
+            raise ArgumentError(f"map_file must be None or a path, got {self.map_file!r}")
+        if self.grid is not None:  # its size, closedness and room: maps.validate_map
+            check_shape("grid", self.grid, (None, None))
+        w = check_int("robot_width", self.robot_width, 1, MAX_ROBOT_WIDTH)
+        R = w if self.sensor_range is None else self.sensor_range
+        R = check_int("sensor_range", R, 1, MAX_SENSOR_RANGE)
+        set_ = object.__setattr__
+        set_(self, "robot_width", w)
+        set_(self, "sensor_range", R)
+        set_(self, "coarse", check_int("coarse", self.coarse, 1, MAX_COARSE))
+        for name in ("heading_noise", "slip_noise"):
+            set_(self, name, check_float(name, getattr(self, name), 0.0, MAX_NOISE))
+        for name in ("sweep", "time", "bump"):
+            set_(self, name, check_float(name, getattr(self, name), -MAX_WEIGHT, MAX_WEIGHT))
+        set_(self, "cell_pixels", check_int("cell_pixels", self.cell_pixels, 1, MAX_CELL_PIXELS))
+        set_(self, "line_of_sight", check_bool("line_of_sight", self.line_of_sight))
+
+    @classmethod
+    def from_kwargs(cls, kwargs: Mapping[str, Any]) -> SweeperParams:
+        """The parameters from an environment's keywords (``render_mode`` and
+        ``max_episode_steps``, which are not the world's, are ignored)."""
+        return params_from_kwargs(cls, kwargs, ignore=("render_mode", "max_episode_steps"))
+
+    @property
+    def window(self) -> int:
+        """``S``: side of the sensing window, ``robot_width + 2 * sensor_range`` cells."""
+        return self.robot_width + 2 * self.sensor_range
+
+    @property
+    def noisy(self) -> bool:
+        """True when odometry noise makes the believed pose drift from the true one."""
+        return self.heading_noise > 0 or self.slip_noise > 0
