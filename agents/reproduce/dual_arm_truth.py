@@ -69,3 +69,32 @@ def _verdict(delay: int | None, truth: int | None, free: np.ndarray) -> str:
     if not free[delay]:
         return "early"  # collides on the v1 check
     return "equal" if delay == truth else f"late {delay - truth}"
+
+
+def print_truth_study(summary: dict[str, object]) -> None:
+    """The study's table: each map's delays against the brute force on the v1 check."""
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(
+        title=f"Boundary following against the exact minimum delay (v1 check), "
+        f"{summary['pairs']} colliding pairs"
+    )
+    for column in ("map", "equal", "early (collides)", "late: by samples", "failed", "median s"):
+        table.add_column(column)
+    for name, label in (("samples_map", "paper's cells (v0)"), ("swept_map", "swept cells (v1)")):
+        row = summary[name]
+        late = row["late_by"]
+        spread = (
+            f"{len(late)}: {min(late)}-{max(late)}, median {np.median(late):g}" if late else "0"
+        )
+        table.add_row(
+            label,
+            str(row["equal"]),
+            str(row["early"]),
+            spread,
+            str(row["failed"]),
+            f"{row['median_s']:.3f}",
+        )
+    Console(width=110).print(table)
+    print(f"brute force over every delay: {summary['truth_median_s']:.2f} s a pair (median)")
