@@ -46,6 +46,12 @@ GOALS: dict[str, tuple[str, float]] = {
     "motiongym/DualArmCell-v0": ("Reacher-v5", 1.0),
     "motiongym/ExcavatorReach-v0": ("Reacher-v5", 1.0),
     "motiongym/Excavator-v0": ("Reacher-v5", 1.0),
+    "motiongym/Sweeper-v1": ("CartPole-v1", 0.3),
+    "motiongym/HarvestArm-v1": ("Reacher-v5", 1.0),
+    "motiongym/HarvestArmPlanar-v1": ("Reacher-v5", 1.0),
+    "motiongym/DualArmCell-v1": ("Reacher-v5", 1.0),
+    "motiongym/ExcavatorReach-v1": ("Reacher-v5", 1.0),
+    "motiongym/Excavator-v1": ("Reacher-v5", 1.0),
 }
 # Vectorised-environment goals: ID -> (least steps/s, least ratio to SyncVectorEnv).
 VECTOR_GOALS: dict[str, tuple[float, float]] = {
@@ -57,6 +63,14 @@ PLANNERS: dict[str, tuple[str, float | None]] = {
     "boundary following, dual-arm paper case": (
         "motiongym.baselines.dual_arm.boundary_following:plan_paper_case",
         0.1,
+    ),
+    "boundary following on the swept map (v1), dual-arm paper case": (
+        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case_swept",
+        0.1,
+    ),
+    "exact delay by brute force (v1 check), dual-arm paper case": (
+        "motiongym.baselines.dual_arm.exact_delay:solve_paper_case",
+        None,
     ),
     "Newton-Raphson IK, excavator paper case": (
         "motiongym.baselines.excavator.newton_raphson:solve_paper_case",

@@ -65,3 +65,11 @@ def true_min_delay(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) ->
     free = free_delays(step_table(traj1, traj2, margin), traj1.n_samples, traj2.n_samples)
     found = np.flatnonzero(free)
     return int(found[0]) if len(found) else None
+
+
+def solve_paper_case() -> int | None:
+    """The exact minimum delay of the paper case (a benchmark hook: the brute force
+    that boundary following is timed against)."""
+    from motiongym.envs.dual_arm.task import paper_case
+
+    return true_min_delay(*paper_case())
