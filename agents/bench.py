@@ -36,47 +36,13 @@ from motiongym.agents.environments import make_env, resolved_env_kwargs
 from motiongym.agents.report import console
 from motiongym.baselines import make_policy, scripted_policies
 from motiongym.envs import ENV_IDS
+from motiongym.systems import declared
 
 REFERENCES = ("CartPole-v1", "Reacher-v5", "MiniGrid-Empty-16x16-v0")
-# Environment throughput goals: ID -> (reference, least ratio to it).
-GOALS: dict[str, tuple[str, float]] = {
-    "motiongym/Sweeper-v0": ("CartPole-v1", 0.3),
-    "motiongym/HarvestArm-v0": ("Reacher-v5", 1.0),
-    "motiongym/HarvestArmPlanar-v0": ("Reacher-v5", 1.0),
-    "motiongym/DualArmCell-v0": ("Reacher-v5", 1.0),
-    "motiongym/ExcavatorReach-v0": ("Reacher-v5", 1.0),
-    "motiongym/Excavator-v0": ("Reacher-v5", 1.0),
-    "motiongym/Sweeper-v1": ("CartPole-v1", 0.3),
-    "motiongym/HarvestArm-v1": ("Reacher-v5", 1.0),
-    "motiongym/HarvestArmPlanar-v1": ("Reacher-v5", 1.0),
-    "motiongym/DualArmCell-v1": ("Reacher-v5", 1.0),
-    "motiongym/ExcavatorReach-v1": ("Reacher-v5", 1.0),
-    "motiongym/Excavator-v1": ("Reacher-v5", 1.0),
-}
-# Vectorised-environment goals: ID -> (least steps/s, least ratio to SyncVectorEnv).
-VECTOR_GOALS: dict[str, tuple[float, float]] = {
-    "motiongym/Sweeper-v0": (1_000_000.0, 100.0),
-}
-# Planners: label -> ("module:function" taking no argument and planning once, goal in s).
-PLANNERS: dict[str, tuple[str, float | None]] = {
-    "PSA + CWA, full run on the maze": ("motiongym.baselines.sweeper.run:sweep", 2.0),
-    "boundary following, dual-arm paper case": (
-        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case",
-        0.1,
-    ),
-    "boundary following on the swept map (v1), dual-arm paper case": (
-        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case_swept",
-        0.1,
-    ),
-    "exact delay by brute force (v1 check), dual-arm paper case": (
-        "motiongym.baselines.dual_arm.exact_delay:solve_paper_case",
-        None,
-    ),
-    "Newton-Raphson IK, excavator paper case": (
-        "motiongym.baselines.excavator.newton_raphson:solve_paper_case",
-        None,
-    ),
-}
+# Goals and planners, as each system declares them (motiongym.systems).
+GOALS: dict[str, tuple[str, float]] = declared("envs", "BENCH_GOALS")
+VECTOR_GOALS: dict[str, tuple[float, float]] = declared("envs", "BENCH_VECTOR_GOALS")
+PLANNERS: dict[str, tuple[str, float | None]] = declared("baselines", "PLANNERS")
 
 
 def machine() -> str:

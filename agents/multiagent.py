@@ -32,6 +32,7 @@ environment (``DualArmCell-v0``: robot 1's advance, then robot 2's).
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -42,22 +43,20 @@ from pettingzoo import ParallelEnv
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
 from motiongym.agents.errors import UsageError
-from motiongym.envs.dual_arm import parallel_env as dual_arm_parallel_env
-
-# Environment IDs that have a PettingZoo parallel version -> its factory.
-PARALLEL_ENVS: dict[str, Callable[..., ParallelEnv]] = {
-    "motiongym/DualArmCell-v0": dual_arm_parallel_env,
-}
+from motiongym.systems import declared
 
 
 def parallel_factory(env_id: str) -> Callable[..., ParallelEnv]:
-    """The factory of ``env_id``'s PettingZoo parallel environment."""
-    if env_id not in PARALLEL_ENVS:
+    """The factory of ``env_id``'s PettingZoo parallel environment (the systems'
+    ``PARALLEL_ENVS`` declarations, :mod:`motiongym.systems`)."""
+    found = declared("envs", "PARALLEL_ENVS")
+    if env_id not in found:
         raise UsageError(
             f"{env_id} has no PettingZoo parallel version (needed by vec_env: pettingzoo); "
-            f"IDs that have one: {', '.join(PARALLEL_ENVS)}"
+            f"IDs that have one: {', '.join(found)}"
         )
-    return PARALLEL_ENVS[env_id]
+    module, function = found[env_id].split(":")
+    return getattr(importlib.import_module(module), function)
 
 
 def slot_observation_space(agent_space: spaces.Box, n_agents: int) -> spaces.Box:

@@ -1,8 +1,9 @@
 """Which scripted policies exist for which environment IDs.
 
-Each system's subpackage declares ``POLICIES``: a mapping from environment ID
-to ``{policy name: "module:Class"}``. Classes are imported only when a policy
-is made.
+Each system's baselines module declares ``POLICIES``: a mapping from
+environment ID to ``{policy name: "module:Class"}`` (the systems are listed
+in :mod:`motiongym.systems`). Classes are imported only when a policy is
+made.
 """
 
 from __future__ import annotations
@@ -13,8 +14,7 @@ from typing import Any
 import gymnasium as gym
 
 from motiongym.baselines.policy import ScriptedPolicy
-
-SYSTEMS = ("sweeper", "harvest_arm", "dual_arm", "excavator")
+from motiongym.systems import declared
 
 
 class UnknownPolicyError(ValueError):
@@ -23,11 +23,7 @@ class UnknownPolicyError(ValueError):
 
 def scripted_policies(env_id: str) -> dict[str, str]:
     """``{name: "module:Class"}`` of the scripted policies for ``env_id``."""
-    found: dict[str, str] = {}
-    for system in SYSTEMS:
-        module = importlib.import_module(f"motiongym.baselines.{system}")
-        found.update(module.POLICIES.get(env_id, {}))
-    return found
+    return dict(declared("baselines", "POLICIES").get(env_id, {}))
 
 
 def make_policy(

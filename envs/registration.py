@@ -1,27 +1,22 @@
 """Registration of every motiongym environment with Gymnasium.
 
-Each system's subpackage declares its IDs in a ``REGISTRATIONS`` tuple of
-keyword dictionaries for :func:`gymnasium.register` (entry points are strings,
-so nothing heavy is imported until an environment is made). This module walks
-the systems once; a new system only adds its name to ``SYSTEMS``.
+Each system's environments module declares its IDs in a ``REGISTRATIONS``
+tuple of keyword dictionaries for :func:`gymnasium.register` (entry points
+are strings, so nothing heavy is imported until an environment is made);
+the systems are listed once, in :mod:`motiongym.systems`.
 """
 
 from __future__ import annotations
 
-import importlib
-
 import gymnasium as gym
 
-SYSTEMS = ("sweeper", "harvest_arm", "dual_arm", "excavator")
+from motiongym.systems import SYSTEMS
+
 NAMESPACE = "motiongym"
 
 
 def _declared() -> list[dict]:
-    declared = []
-    for system in SYSTEMS:
-        module = importlib.import_module(f"motiongym.envs.{system}")
-        declared.extend(module.REGISTRATIONS)
-    return declared
+    return [spec for system in SYSTEMS for spec in system.envs_module().REGISTRATIONS]
 
 
 def register_all() -> None:
@@ -31,4 +26,9 @@ def register_all() -> None:
             gym.register(**spec)
 
 
-ENV_IDS: tuple[str, ...] = tuple(spec["id"] for spec in _declared())
+def env_ids() -> tuple[str, ...]:
+    """Every declared ID, systems added at run time included."""
+    return tuple(spec["id"] for spec in _declared())
+
+
+ENV_IDS: tuple[str, ...] = env_ids()

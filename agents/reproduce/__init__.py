@@ -13,21 +13,20 @@ from pathlib import Path
 from typing import Any
 
 from motiongym.agents.errors import UsageError
+from motiongym.systems import SYSTEMS
 
-EXPERIMENTS = {
-    "sweeper": "motiongym.agents.reproduce.sweeper",
-    "harvest-arm": "motiongym.agents.reproduce.harvest_arm",
-    "dual-arm": "motiongym.agents.reproduce.dual_arm",
-    "excavator": "motiongym.agents.reproduce.excavator",
-}
+
+def experiments() -> dict[str, str]:
+    """``{experiment name: module}`` of every system that declares a reproduction."""
+    return {s.name: s.reproduction for s in SYSTEMS if s.reproduction is not None}
+
+
+EXPERIMENTS = experiments()
 
 
 def reproduce(name: str, out_dir: Path, quick: bool = False) -> dict[str, Any]:
-    """Run the experiment ``name`` (one of :data:`EXPERIMENTS`)."""
-    if name not in EXPERIMENTS:
-        raise UsageError(f"unknown experiment {name!r}; valid: {', '.join(EXPERIMENTS)}")
-    try:
-        module = importlib.import_module(EXPERIMENTS[name])
-    except ModuleNotFoundError as error:
-        raise UsageError(f"experiment {name!r} is not built yet ({error})") from error
-    return module.run(out_dir, quick=quick)
+    """Run the experiment ``name`` (one of :func:`experiments`)."""
+    found = experiments()
+    if name not in found:
+        raise UsageError(f"unknown experiment {name!r}; valid: {', '.join(found)}")
+    return importlib.import_module(found[name]).run(out_dir, quick=quick)

@@ -15,3 +15,19 @@ POLICIES: dict[str, dict[str, str]] = {
     },
 }
 POLICIES["motiongym/DualArmCell-v1"] = dict(POLICIES["motiongym/DualArmCell-v0"])
+
+# Planning times of `motiongym bench`: label -> ("module:function", goal in s).
+PLANNERS: dict[str, tuple[str, float | None]] = {
+    "boundary following, dual-arm paper case": (
+        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case",
+        0.1,
+    ),
+    "boundary following on the swept map (v1), dual-arm paper case": (
+        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case_swept",
+        0.1,
+    ),
+    "exact delay by brute force (v1 check), dual-arm paper case": (
+        "motiongym.baselines.dual_arm.exact_delay:solve_paper_case",
+        None,
+    ),
+}

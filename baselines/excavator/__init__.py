@@ -15,3 +15,11 @@ POLICIES: dict[str, dict[str, str]] = {
         "dig-cycle": "motiongym.baselines.excavator.policies:DigCyclePolicy",
     },
 }
+
+# Planning times of `motiongym bench`: label -> ("module:function", goal in s).
+PLANNERS: dict[str, tuple[str, float | None]] = {
+    "Newton-Raphson IK, excavator paper case": (
+        "motiongym.baselines.excavator.newton_raphson:solve_paper_case",
+        None,
+    ),
+}

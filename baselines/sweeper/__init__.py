@@ -9,3 +9,8 @@ POLICIES: dict[str, dict[str, str]] = {
         "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
     },
 }
+
+# Planning times of `motiongym bench`: label -> ("module:function", goal in s).
+PLANNERS: dict[str, tuple[str, float | None]] = {
+    "PSA + CWA, full run on the maze": ("motiongym.baselines.sweeper.run:sweep", 2.0),
+}

@@ -30,3 +30,20 @@ def parallel_env(**kwargs: Any):  # -> DualArmParallelEnv
     from motiongym.envs.dual_arm.parallel import DualArmParallelEnv
 
     return DualArmParallelEnv(**kwargs)
+
+
+def parallel_env_v1(**kwargs: Any):  # -> DualArmParallelEnv
+    """:func:`parallel_env` on ``DualArmCell-v1``'s check (the motion between samples)."""
+    return parallel_env(**{"collision_check": "swept", **kwargs})
+
+
+# PettingZoo versions of IDs: ID -> "module:factory".
+PARALLEL_ENVS: dict[str, str] = {
+    "motiongym/DualArmCell-v0": "motiongym.envs.dual_arm:parallel_env",
+    "motiongym/DualArmCell-v1": "motiongym.envs.dual_arm:parallel_env_v1",
+}
+# Throughput goals of `motiongym bench`: ID -> (reference ID, least ratio to it).
+BENCH_GOALS: dict[str, tuple[str, float]] = {
+    "motiongym/DualArmCell-v0": ("Reacher-v5", 1.0),
+    "motiongym/DualArmCell-v1": ("Reacher-v5", 1.0),
+}

@@ -30,3 +30,10 @@ REGISTRATIONS: tuple[dict, ...] = (
         "kwargs": {"physics": "v1", "slope": 0.1},
     },
 )
+
+# Throughput goals of `motiongym bench`: ID -> (reference ID, least ratio to it).
+BENCH_GOALS: dict[str, tuple[str, float]] = {
+    f"motiongym/{name}-{version}": ("Reacher-v5", 1.0)
+    for name in ("Excavator", "ExcavatorReach")
+    for version in ("v0", "v1")
+}

@@ -36,3 +36,10 @@ REGISTRATIONS: tuple[dict, ...] = (
         "kwargs": {"dof": 5, "planar": True, "self_collision": True},
     },
 )
+
+# Throughput goals of `motiongym bench`: ID -> (reference ID, least ratio to it).
+BENCH_GOALS: dict[str, tuple[str, float]] = {
+    f"motiongym/{name}-{version}": ("Reacher-v5", 1.0)
+    for name in ("HarvestArm", "HarvestArmPlanar")
+    for version in ("v0", "v1")
+}
