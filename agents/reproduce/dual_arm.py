@@ -124,6 +124,7 @@ def _run_in_env(policy_name: str, seeds=(0,), task_mode: str = "paper") -> dict[
     import gymnasium as gym
 
     import motiongym  # noqa: F401
+    from motiongym.agents.evaluate import run_episode
     from motiongym.baselines import make_policy
 
     env_id = "motiongym/DualArmCell-v0"
@@ -131,16 +132,11 @@ def _run_in_env(policy_name: str, seeds=(0,), task_mode: str = "paper") -> dict[
     policy = make_policy(env_id, policy_name, env.observation_space, env.action_space, {})
     success, spans, min_d, replans = [], [], np.inf, 0
     for seed in seeds:
-        obs, info = env.reset(seed=int(seed))
-        policy.reset()
-        done = False
-        while not done:
-            action, _ = policy.predict(obs)
-            obs, _, terminated, truncated, info = env.step(action)
-            min_d, done = min(min_d, info["distance"]), terminated or truncated
-        success.append(info["is_success"])
-        spans.append(info["makespan"])
-        replans += policy._memories[0]["replans"] > 0
+        result = run_episode(env, policy, int(seed))  # distance: the episode's minimum
+        min_d = min(min_d, result["distance"])
+        success.append(bool(result["is_success"]))
+        spans.append(result["makespan"])
+        replans += policy.diagnostics()["replans"] > 0
     return {
         "is_success": bool(all(success)),
         "success_rate": float(np.mean(success)),
@@ -156,7 +152,7 @@ def _paper_figures(out_dir, cmap, result, t_und, d_und, t_del, d_del, best) -> N
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from motiongym.baselines.dual_arm.figures import plot_collision_map, plot_distance
+    from motiongym.agents.reproduce.dual_arm_figures import plot_collision_map, plot_distance
 
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.2))
     plot_distance(axes[0], t_und, d_und, "Fig. 7: distance, both start together")

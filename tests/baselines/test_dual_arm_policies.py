@@ -62,5 +62,4 @@ def test_batched_predict_keeps_one_plan_per_env():
     b, _ = env.reset(seed=2)
     actions, _ = policy.predict(np.stack([a, b]), episode_start=np.array([True, True]))
     assert actions.shape == (2, 2)
-    assert len(policy._memories) == 2
-    assert policy._memories[0]["result"].delay != policy._memories[1]["result"].delay
+    assert policy.diagnostics(0)["delay"] != policy.diagnostics(1)["delay"]
