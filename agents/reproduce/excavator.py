@@ -37,8 +37,16 @@ import numpy as np
 
 from motiongym.baselines.excavator import newton_raphson as nr
 from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
-from motiongym.envs.excavator.kinematics import bucket_angle, forward, link_frames, swing_for_target
+from motiongym.envs.excavator.kinematics import (
+    bucket_angle,
+    desired_pose,
+    forward,
+    link_frames,
+    swing_for_target,
+)
+from motiongym.envs.excavator.observation import layout
 
+DIG_ID = "motiongym/Excavator-v0"
 V_NAMES = ("E(1,1)", "E(3,1)", "E(1,4)", "E(2,4)", "E(3,4)")
 
 
@@ -100,8 +108,8 @@ def random_poses(n: int, seed: int = 0) -> dict[str, Any]:
             reasons[r.reason] += 1
             if r.converged:
                 iterations.append(r.iterations)
-                hq = forward(r.q, M)
-                wrong += bool(np.linalg.norm(hq[:3, 3] - h[:3, 3]) > 1e-3)
+                h_d = desired_pose(h[:3, 3], bucket_angle(q), M)
+                wrong += not _same_pose(forward(r.q, M), h_d)
         elapsed = time.perf_counter() - start
         out[name] = {
             "n": n,
@@ -168,70 +176,147 @@ def unreachable(n: int, seed: int = 1) -> dict[str, Any]:
     return {"n": n, "reasons": dict(reasons), "reported_converged": false_success}
 
 
-def dig_cycles(n: int) -> dict[str, Any]:
-    """The dig-cycle policy on ``n`` seeded scenes of Excavator-v0."""
+def _same_pose(h: np.ndarray, h_d: np.ndarray, tol: float = 1e-3) -> bool:
+    """Tip within ``tol`` m and both bucket axes (x, z) within ``tol`` rad."""
+    axes = [math.acos(min(float(h[:3, k] @ h_d[:3, k]), 1.0)) for k in (0, 2)]
+    return bool(np.linalg.norm(h[:3, 3] - h_d[:3, 3]) < tol + 1e-9 and max(axes) < tol + 1e-9)
+
+
+def cartesian_targets(n: int, seed: int) -> list[tuple[np.ndarray, float]]:
+    """Tips uniform (by area) in a cylinder of radius 11 m about the swing axis, z in
+    [-8, 11] m (the machine's whole envelope and beyond), beta uniform in [-pi, pi)."""
+    rng = np.random.default_rng(seed)
+    r = 11.0 * np.sqrt(rng.uniform(size=n))
+    phi = rng.uniform(-math.pi, math.pi, size=n)
+    z = rng.uniform(-8.0, 11.0, size=n)
+    beta = rng.uniform(-math.pi, math.pi, size=n)
+    return [
+        (np.array([r[k] * math.cos(phi[k]), r[k] * math.sin(phi[k]), z[k]]), float(beta[k]))
+        for k in range(n)
+    ]
+
+
+def cartesian_ik(n: int, seed: int = 12) -> dict[str, Any]:
+    """IK on ``n`` targets sampled in Cartesian space (most of them unreachable).
+
+    Starts: the paper's literal rest pose; the rest pose with the swing
+    pointed at the target; the policies' fallback chain
+    (:func:`~motiongym.baselines.excavator.tracking.solve_pose`). Per start:
+    the reasons, the convergence rate over the targets with an in-limit
+    solution (closed form), a "no solution" reason given where the closed form
+    has one (must be 0), and poses reported converged whose tip or either
+    bucket axis (matrix product of eq. 4) is off (must be 0).
+    """
+    from motiongym.baselines.excavator.tracking import solve_pose
+
+    targets = cartesian_targets(n, seed)
+    solvable = [nr.solution_exists(tip, beta, M) for tip, beta in targets]
+    starts = {
+        "newton_rest": lambda tip, beta: nr.solve(tip, beta, M),
+        "newton_rest_swing_aligned": lambda tip, beta: nr.solve(
+            tip, beta, M, q0=(swing_for_target(tip[0], tip[1], M), *M.q_rest[1:])
+        ),
+        "fallback_chain": lambda tip, beta: solve_pose(tip, beta, M),
+    }
+    out: dict[str, Any] = {"n": n, "seed": seed, "with_in_limit_solution": int(sum(solvable))}
+    for name, solver in starts.items():
+        reasons, wrong, denied = collections.Counter(), 0, 0
+        for (tip, beta), exists in zip(targets, solvable, strict=True):
+            r = solver(tip, beta)
+            reasons[r.reason] += 1
+            denied += exists and r.reason in nr.NO_SOLUTION
+            if r.converged:
+                wrong += not _same_pose(forward(r.q, M), desired_pose(tip, beta, M))
+        out[name] = {
+            "reasons": dict(reasons),
+            "converged_rate_of_solvable": reasons["converged"] / max(sum(solvable), 1),
+            "no_solution_reason_with_in_limit_solution": int(denied),
+            "wrong_pose_reported_converged": wrong,
+        }
+    return out
+
+
+def issue_case() -> dict[str, Any]:
+    """The issue's flipped bucket: ``solve([-0.028, 0.09, -3.665], -0.078)`` from rest."""
+    tip, beta = np.array([-0.028, 0.09, -3.665]), -0.078
+    r = nr.solve(tip, beta, M)
+    return {
+        "converged": r.converged,
+        "reason": r.reason,
+        "q2+q3+q4": float(r.q[1:].sum()),
+        "frame_rotation_error_rad": r.angle_error,
+        "in_limit_solution_exists": r.solution_exists,
+    }
+
+
+def dig_cycles(n: int, env_id: str = DIG_ID) -> dict[str, Any]:
+    """The dig-cycle policy on ``n`` seeded scenes of ``env_id`` (seeds 0 .. n-1).
+
+    Episodes run through :func:`~motiongym.agents.evaluate.run_episode`; a
+    hook times the policy and reads its public ``diagnostics()`` (the cut depth
+    it chose) and the zone's marked depth from the observation.
+    """
     import gymnasium as gym
 
+    from motiongym.agents.evaluate import run_episode
     from motiongym.baselines.registry import make_policy
 
-    env_id = "motiongym/Excavator-v0"
     env = gym.make(env_id)
-    policy = make_policy(env_id, "dig-cycle", env.observation_space, env.action_space, {})
+    policy = _TimedPolicy(make_policy(env_id, "dig-cycle", env.observation_space, env.action_space))
+    zone = layout("dig")["zone"]
     rows = []
-    policy_time, steps = 0.0, 0
     for seed in range(n):
-        obs, info = env.reset(seed=seed)
-        start, done, cost, min_pipe, min_truck = True, False, 0.0, math.inf, math.inf
-        while not done:
-            t = time.perf_counter()
-            action, _ = policy.predict(obs, episode_start=start)
-            policy_time += time.perf_counter() - t
-            steps += 1
-            start = False
-            obs, _, terminated, truncated, info = env.step(action)
-            cost += info["cost"]
-            min_pipe = min(min_pipe, info["pipe_clearance"])
-            min_truck = min(min_truck, info["truck_clearance"])
-            done = terminated or truncated
-        memory = policy._memories[0]
-        rows.append(
-            {
-                "seed": seed,
-                "success": bool(info["is_success"]),
-                "dig_fill": info["dig_fill"],
-                "truck_soil": info["truck_soil"],
-                "spill": info["spill"],
-                "outside_zone": info["outside_zone"],
-                "pipe_contact": info["pipe_contact"],
-                "cost_steps": cost,
-                "min_pipe_clearance": min_pipe,
-                "min_truck_clearance": min_truck,
-                "cycle_time_s": info["elapsed"],
-                "cut_depth": memory.get("depth"),
-                "marked_depth": float(env.unwrapped.scene.zone.depth),
-            }
-        )
+        seen: dict[str, Any] = {}
+
+        def hook(step, seen=seen) -> None:
+            seen["cut_depth"] = policy.diagnostics().get("cut_depth")
+            seen["marked_depth"] = float(step.observation[zone][4])
+            seen["delivered"] = float(step.info["truck_soil"])
+
+        episode = run_episode(env, policy, seed, hook=hook)
+        rows.append({**episode, **seen, "success": bool(episode["is_success"])})
     env.close()
 
     def stat(key: str) -> dict[str, float]:
         v = np.array([r[key] for r in rows], dtype=float)
         return {"mean": float(v.mean()), "min": float(v.min()), "max": float(v.max())}
 
+    limited = [r for r in rows if r["cut_depth"] is not None]
     return {
+        "env_id": env_id,
         "n": n,
         "success_rate": float(np.mean([r["success"] for r in rows])),
         "dig_fill_m3": stat("dig_fill"),
         "truck_soil_m3": stat("truck_soil"),
         "spill_m3": stat("spill"),
         "outside_zone_m3": stat("outside_zone"),
-        "pipe_contacts": int(sum(r["pipe_contact"] for r in rows)),
-        "cost_steps_total": float(sum(r["cost_steps"] for r in rows)),
-        "min_pipe_clearance_m": float(min(r["min_pipe_clearance"] for r in rows)),
-        "cycle_time_s": stat("cycle_time_s"),
-        "depth_limited_by_pipe": int(sum(r["cut_depth"] < r["marked_depth"] - 1e-9 for r in rows)),
-        "policy_ms_per_step": 1e3 * policy_time / max(steps, 1),
+        "pipe_contacts": int(sum(r["pipe_contact"] > 0 for r in rows)),
+        "cost_steps_total": float(sum(r["cost"] for r in rows)),
+        "min_pipe_clearance_m": float(min(r["pipe_clearance"] for r in rows)),
+        "cycle_time_s": stat("elapsed"),
+        "depth_limited_by_pipe": int(
+            sum(r["cut_depth"] < r["marked_depth"] - 1e-9 for r in limited)
+        ),
+        "policy_ms_per_step": 1e3 * policy.seconds / max(policy.calls, 1),
         "episodes": rows,
     }
+
+
+class _TimedPolicy:
+    """A predictor that times another one's ``predict`` (and passes ``diagnostics``)."""
+
+    def __init__(self, inner) -> None:
+        self.inner, self.seconds, self.calls = inner, 0.0, 0
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        start = time.perf_counter()
+        out = self.inner.predict(observation, state, episode_start, deterministic)
+        self.seconds += time.perf_counter() - start
+        self.calls += 1
+        return out
+
+    def diagnostics(self, index: int = 0) -> dict[str, Any]:
+        return self.inner.diagnostics(index)
 
 
 def speed(n_steps: int) -> dict[str, float]:
@@ -353,6 +438,22 @@ def _print(results: dict[str, Any]) -> None:
             f"{100 * r['converged_rate']:.1f} % conv. {r['reasons']}",
             "-",
         )
+    c = results["issue_case"]
+    table.add_row(
+        "issue's flipped bucket: converged / reason / q2+q3+q4",
+        f"{c['converged']} / {c['reason']} / {c['q2+q3+q4']:.3f} rad",
+        "-",
+    )
+    cart = results["cartesian_ik"]
+    for name in ("newton_rest", "newton_rest_swing_aligned", "fallback_chain"):
+        r = cart[name]
+        table.add_row(
+            f"{cart['n']} Cartesian targets ({cart['with_in_limit_solution']} solvable), {name}",
+            f"{100 * r['converged_rate_of_solvable']:.1f} % of solvable conv.; wrong "
+            f"{r['wrong_pose_reported_converged']}; 'no solution' for solvable "
+            f"{r['no_solution_reason_with_in_limit_solution']}; {r['reasons']}",
+            "-",
+        )
     u = results["unreachable"]
     table.add_row(
         "unreachable targets reported converged",
@@ -404,6 +505,8 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
         "random_poses": random_poses(100 if quick else 1000),
         "near_singular": near_singular(40 if quick else 200),
         "unreachable": unreachable(40 if quick else 200),
+        "issue_case": issue_case(),
+        "cartesian_ik": cartesian_ik(300 if quick else 3000),
         "dig_cycle": dig_cycles(8 if quick else 100),
         "speed": speed(2000 if quick else 20000),
     }

@@ -92,6 +92,11 @@ class DigCyclePolicy(_ExcavatorPolicy):
     def new_memory(self) -> dict:
         return {"stage": None, "goals": None, "index": 0, "depth": None}
 
+    def describe(self, memory: dict) -> dict:
+        """``stage`` (None, "approach", "dig", "lift", "dump"), ``cut_depth`` (m, None
+        before the dig is planned) and ``waypoint`` (index of the goal tracked)."""
+        return {"stage": memory["stage"], "cut_depth": memory["depth"], "waypoint": memory["index"]}
+
     def _set(self, memory: dict, stage: str, waypoints: list[bp.Waypoint], q: np.ndarray):
         goals, q_prev = [], q
         for wp in waypoints:

@@ -32,6 +32,12 @@ def test_ik_statistics_and_failures_are_honest(results):
         assert stats["wrong_pose_reported_converged"] == 0
     assert r["random_poses"]["newton_rest_aligned"]["converged_rate"] >= 0.9
     assert r["unreachable"]["reported_converged"] == 0
+    assert not r["issue_case"]["converged"] and r["issue_case"]["reason"] == "joint_limits"
+    cart = r["cartesian_ik"]
+    for name in ("newton_rest", "newton_rest_swing_aligned", "fallback_chain"):
+        assert cart[name]["wrong_pose_reported_converged"] == 0
+        assert cart[name]["no_solution_reason_with_in_limit_solution"] == 0
+    assert cart["fallback_chain"]["converged_rate_of_solvable"] == 1.0
 
 
 def test_dig_cycle_numbers(results):

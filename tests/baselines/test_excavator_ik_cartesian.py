@@ -15,6 +15,7 @@ import math
 import numpy as np
 import pytest
 
+from motiongym.agents.reproduce.excavator import cartesian_targets
 from motiongym.baselines.excavator import newton_raphson as nr
 from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
 from motiongym.envs.excavator.config import Machine
@@ -100,19 +101,6 @@ def own_existence(tip, beta, m: Machine) -> tuple[bool, float]:
         exists |= bool(np.all(gaps >= 0.0))
         edge = min(edge, float(np.min(np.abs(gaps[1:]))))
     return exists, edge
-
-
-def cartesian_targets(n: int, seed: int) -> list[tuple[np.ndarray, float]]:
-    """Tips uniform (by area) in a cylinder of radius 11 m, z in [-8, 11] m; beta in [-pi, pi)."""
-    rng = np.random.default_rng(seed)
-    r = 11.0 * np.sqrt(rng.uniform(size=n))
-    phi = rng.uniform(-math.pi, math.pi, size=n)
-    z = rng.uniform(-8.0, 11.0, size=n)
-    beta = rng.uniform(-math.pi, math.pi, size=n)
-    return [
-        (np.array([r[k] * math.cos(phi[k]), r[k] * math.sin(phi[k]), z[k]]), float(beta[k]))
-        for k in range(n)
-    ]
 
 
 def audit(n: int, seed: int, m: Machine) -> collections.Counter:
