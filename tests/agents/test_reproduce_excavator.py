@@ -68,3 +68,11 @@ def test_full_protocol(tmp_path):
     assert near["lm"]["converged_rate"] > near["newton"]["converged_rate"]
     d = r["dig_cycle"]
     assert d["n"] == 100 and d["success_rate"] >= 0.98 and d["pipe_contacts"] == 0
+
+
+def test_probes_report_every_issue_probe(results):
+    _, r = results
+    probes = r["probes"]
+    for name in ("heel_first_push", "sideways_swing", "curled_plunge", "boom_into_ground"):
+        assert isinstance(probes[name]["physical"], bool), name
+    assert probes["dragged_full_bucket"]["full_at_step"] is not None

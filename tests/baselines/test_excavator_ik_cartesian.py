@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from motiongym.agents.reproduce.excavator import cartesian_targets
+from motiongym.agents.reproduce.excavator_ik import cartesian_targets
 from motiongym.baselines.excavator import newton_raphson as nr
 from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
 from motiongym.envs.excavator.config import Machine
