@@ -1,11 +1,20 @@
 """Joint-rate tracking within the hydraulic limits, and IK with fallbacks.
 
 Tracking: to move from ``q`` to ``q*`` in steps of ``dt`` with joint rates
-limited to ``rate_max``, command ``a = (q* - q) / (rate_max dt)`` scaled
-down by ``max(1, max |a|)``: every joint arrives at the same time (a
-straight line in joint space) at the speed of the slowest one, and the last
-step lands exactly (dead-beat). Actions are fractions of ``rate_max``, the
-environments' action convention.
+limited to ``rate_max``, command the rate ``v = lambda (q* - q)`` along the
+straight line in joint space (every joint arrives at the same time, at the
+speed of the slowest one) with the largest ``lambda`` that keeps
+
+* every rate within ``rate_max``: ``lambda |e_j| <= rate_max_j``;
+* the last step exact (dead-beat): ``lambda <= 1 / dt``;
+* with acceleration limits ``accel_max`` (rad/s2): every joint able to stop
+  at the goal in steps of ``dt`` (``v^2 / (2 a) + v dt / 2 <= |e|``), and
+  each rate within ``accel_max_j dt`` of the current one (the observed
+  ``qdot``).
+
+Actions are fractions of ``rate_max``, the environments' action convention.
+Without acceleration limits this is ``a = (q* - q) / (rate_max dt)`` scaled
+down by ``max(1, max |a|)``.
 
 IK: :func:`solve_pose` runs the paper's Newton-Raphson (eq. 13) from the
 given start with the swing pointed at the target and the bucket turned to the
@@ -28,11 +37,38 @@ from motiongym.envs.excavator.config import Machine
 from motiongym.envs.excavator.kinematics import swing_for_target
 
 
-def track(q: np.ndarray, q_goal: np.ndarray, m: Machine, dt: float) -> np.ndarray:
-    """Normalised joint-rate action (4,) toward ``q_goal`` (synchronised, dead-beat)."""
-    raw = (np.asarray(q_goal, float) - np.asarray(q, float)) / (np.array(m.rate_max) * dt)
+def track(
+    q: np.ndarray,
+    q_goal: np.ndarray,
+    m: Machine,
+    dt: float,
+    qdot: np.ndarray | None = None,
+    accel_max: np.ndarray | None = None,
+) -> np.ndarray:
+    """Normalised joint-rate action (4,) toward ``q_goal`` (synchronised, dead-beat).
+
+    ``accel_max`` (4,) rad/s2, with the current rates ``qdot`` (4,): brake in
+    time for the goal and change no rate by more than ``accel_max dt``.
+    """
+    rate_max = np.array(m.rate_max)
+    error = np.asarray(q_goal, float) - np.asarray(q, float)
+    raw = error / (rate_max * dt)
     scale = max(1.0, float(np.max(np.abs(raw))))
-    return (raw / scale).astype(np.float32)
+    if accel_max is None:
+        return (raw / scale).astype(np.float32)
+    accel = np.asarray(accel_max, float)
+    moving = np.abs(error) > 1e-12
+    lam = 1.0 / (dt * scale)
+    if np.any(moving):
+        # Stopping from rate v at accel a in steps of dt takes v^2 / (2 a) + v dt / 2.
+        a, e = accel[moving], np.abs(error[moving])
+        stop = a * (np.sqrt(0.25 * dt * dt + 2.0 * e / a) - 0.5 * dt)
+        lam = min(lam, float(np.min(stop / e)))
+    rate = lam * error
+    if qdot is not None:
+        step = accel * dt
+        rate = np.clip(rate, np.asarray(qdot, float) - step, np.asarray(qdot, float) + step)
+    return np.clip(rate / rate_max, -1.0, 1.0).astype(np.float32)
 
 
 def solve_pose(
