@@ -20,6 +20,12 @@ bucket opening faces ``(sin beta, -cos beta)`` in the boom plane):
 * swing: the same pose at the truck's azimuth (only the swing joint moves);
 * dump: bucket pin fixed, ``beta = -0.35`` (opening down: the soil pours).
 
+Attitude: wherever the tip is in the soil, it moves with the bucket opening
+ahead (opening normal . motion > 0): down and inwards while penetrating,
+inwards while dragging, along the opening while curling about the pin
+(curling turns the tip exactly along the opening normal). Nothing cuts heel
+first or sideways (tested).
+
 Pipe: the cut depth is the zone's marked depth, or less where the pipe runs
 within reach of the strip in plan: then the bucket's lowest point (tip minus
 the bucket radius) stays ``safety + 0.25 m`` above the pipe's top.

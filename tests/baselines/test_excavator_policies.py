@@ -143,3 +143,42 @@ def test_tracking_with_acceleration_limits_ramps_and_stops_at_the_goal():
     # Ablation: without the limits the first step asks for full rate at once.
     first = track(np.zeros(4), goal, M, dt) * rate_max
     assert np.max(np.abs(first) / accel) / dt > 10.0
+
+
+def _executed_tip_path(waypoints, q_start):
+    """Tip (r, z) and bucket angle along the joint-space straight lines the tracker follows."""
+    from motiongym.envs.excavator.kinematics import arm_points
+
+    q_prev, out = q_start, []
+    for wp in waypoints:
+        q_goal = solve_pose(np.array(wp.tip), wp.beta, M, q_prev).q
+        for s in np.linspace(0.0, 1.0, 21)[1:]:
+            q = q_prev + s * (q_goal - q_prev)
+            tip = arm_points(*q, M)[3]
+            out.append((np.hypot(tip[0], tip[1]), tip[2], float(q[1:].sum())))
+        q_prev = q_goal
+    return np.array(out), q_prev
+
+
+def test_the_bucket_cuts_only_with_its_opening_ahead():
+    rng = np.random.default_rng(5)
+    worst = np.inf
+    for _ in range(20):
+        r_far = rng.uniform(7.0, 8.5)
+        r_near = r_far - rng.uniform(2.5, 3.5)
+        depth = rng.uniform(0.3, 1.0)
+        tilt = rng.uniform(-0.03, 0.03)
+        surface = lambda r, t=tilt: t * (r - 6.0)  # noqa: E731
+        path = bp.dig_path(rng.uniform(-0.6, 0.6), r_near, r_far, depth, surface)
+        rzb, q_end = _executed_tip_path(path, np.array(M.q_ready))
+        tip = np.array(path[-1].tip)
+        curl = bp.curl_lift_path(tip, path[-1].beta, surface(np.hypot(*tip[:2])), M)
+        rzb2, _ = _executed_tip_path(curl[:1], q_end)
+        rzb = np.vstack([rzb, rzb2])
+        motion = np.diff(rzb[:, :2], axis=0)
+        length = np.linalg.norm(motion, axis=1)
+        n = np.stack([np.sin(rzb[1:, 2]), -np.cos(rzb[1:, 2])], axis=1)
+        in_soil = (rzb[1:, 1] < surface(rzb[1:, 0]) - 0.02) & (length > 1e-6)
+        cosine = np.sum(n * motion, axis=1)[in_soil] / length[in_soil]
+        worst = min(worst, float(cosine.min()))
+    assert worst > 0.3  # never heel first or sideways: within 73 deg of the opening
