@@ -18,6 +18,16 @@ the verdict by the stated rule:
 * ``dragged_full_bucket``: bucket 0.6 m deep dragged 4.5 m inwards; after it
   is full, its edge still moves through soil. Physical: the terrain changes
   (> 0.01 m3, soil pushed) or the tip stops (moves < 0.5 m in soil).
+* ``pipe_beside_boom_plane``: a scene whose pipe runs parallel to a boom
+  plane 0.6-0.7 m beside it; the bucket (edge vertical-ish) at the pipe's
+  depth in that plane. Physical: contact reported when the cutting edge's
+  corner (half the bucket width out of the plane) is inside the pipe (our
+  own segment distance), and not when it is outside.
+* ``bucket_in_tracks``: joint angles drawn uniformly in the ranges, each set
+  at reset: the share that puts the bucket segment (pin to edge, with its
+  half width) inside the undercarriage box :data:`UNDERCARRIAGE`, or the tip
+  under its footprint below ground, and how many of those the world reports
+  as a contact. Physical: every such pose is reported.
 
 The probes run on the azimuth opposite the truck, on seed 0's ground.
 """
@@ -39,6 +49,9 @@ from motiongym.envs.excavator.kinematics import arm_points
 from motiongym.envs.excavator.observation import layout
 
 FILL_NONE = 0.05  # m3: "no fill"
+# A 20 t crawler's undercarriage about the swing axis (m): 4.45 m long over the
+# tracks, 2.98 m wide over 600 mm shoes, 0.92 m high (Cat 320 class brochures).
+UNDERCARRIAGE = {"half_length": 2.225, "half_width": 1.49, "height": 0.92}
 REACHED = 2e-3  # rad
 
 
@@ -213,12 +226,6 @@ PROBES = {
 }
 
 
-def run_probes(env_id: str) -> dict[str, Any]:
-    """Every probe of :data:`PROBES` on ``env_id``."""
-    world = _World(env_id)
-    return {"env_id": env_id, **{name: probe(world) for name, probe in PROBES.items()}}
-
-
 def table_rows(probes: dict[str, Any]) -> list[tuple[str, str, str]]:
     """``(measure, ours, issue)`` rows for the reproduction's table."""
     issue = {
@@ -227,13 +234,135 @@ def table_rows(probes: dict[str, Any]) -> list[tuple[str, str, str]]:
         "curled_plunge": "0.1 m3 for 1 m",
         "boom_into_ground": "tip 2.4 m, pin 1.0 m below",
         "dragged_full_bucket": "terrain unchanged",
+        "pipe_beside_boom_plane": "+0.05 m, no contact, corner 0.1 m inside",
+        "bucket_in_tracks": "1.4 % inside, 13.5 % tip under, none reported",
     }
     rows = []
-    for name in PROBES:
+    for name in issue:
         result = dict(probes[name])
         verdict = {True: "physical", False: "NOT physical", None: "n/a"}[result.pop("physical")]
-        numbers = ", ".join(
-            f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in result.items()
-        )
+        numbers = ", ".join(f"{k} {_fmt(v)}" for k, v in result.items())
         rows.append((f"probe {name} ({probes['env_id']})", f"{verdict}: {numbers}", issue[name]))
     return rows
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} {_fmt(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, list):
+        return "[" + ", ".join(_fmt(v) for v in value) + "]"
+    return str(value)
+
+
+def _edge_to_axis(tip, swing: float, half: float, a, b) -> float:
+    """Distance (m) from the cutting edge (``half`` each side of the plane at ``tip``)
+    to the pipe's axis segment ``a``-``b``, by sampling the edge (1 mm steps)."""
+    across = np.array([math.sin(swing), -math.cos(swing), 0.0])
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    ab = b - a
+    points = np.asarray(tip, float) + np.linspace(-half, half, 1201)[:, None] * across
+    t = np.clip((points - a) @ ab / (ab @ ab), 0.0, 1.0)
+    return float(np.min(np.linalg.norm(points - (a + t[:, None] * ab), axis=1)))
+
+
+def pipe_beside_boom_plane(env_id: str, seeds=range(400)) -> dict[str, Any]:
+    """See the module docstring; the first seed whose pipe fits is used."""
+    m = machine_from_kwargs(None)
+    env = gym.make(env_id, max_episode_steps=1)
+    lay = layout("dig")
+    for seed in seeds:
+        obs, _ = env.reset(seed=seed)
+        pipe = obs[lay["pipe"]].astype(float)
+        a, b, radius = pipe[0:3], pipe[3:6], pipe[6]
+        d = (b - a)[:2] / np.linalg.norm((b - a)[:2])
+        offset = float(a[0] * d[1] - a[1] * d[0])  # the pipe's line, signed, from the axis
+        span = sorted((float(a[:2] @ d), float(b[:2] @ d)))  # the pipe along the plane
+        r = 6.0 if span[0] < 5.0 and span[1] > 7.0 else -6.0
+        if 0.6 <= abs(offset) <= 0.7 and span[0] < r - 1.0 and span[1] > r + 1.0:
+            break
+    else:
+        return {"seed": None, "physical": None}
+    swing, r = math.atan2(d[1], d[0]) + (math.pi if r < 0 else 0.0), abs(r)
+    tip = np.array([r * math.cos(swing), r * math.sin(swing), float(a[2])])
+    result = solve_pose(tip, -1.6, m)
+    world = _World(env_id, seed)
+    reported, corner = [], []
+    half = 0.5 * m.bucket_width
+
+    def gap(q) -> float:  # our own edge-corner distance to the pipe's surface
+        return _edge_to_axis(arm_points(*q, m)[3], q[0], half, a, b) - radius
+
+    away = max((1.0, -1.0), key=lambda sign: gap(result.q + [sign * 0.2 / r, 0, 0, 0]))
+    for shift in (0.0, 0.2):  # the edge's corner inside, then outside the pipe
+        q0 = result.q + [away * shift / r, 0.0, 0.0, 0.0]
+        policy = JointGoals(*world.space, [q0], m, world.dt)
+        info: dict[str, Any] = {}
+        run_episode(
+            env, policy, seed, hook=lambda step, i=info: i.update(step.info), options={"q0": q0}
+        )
+        corner.append(gap(q0))
+        reported.append(
+            {"clearance_m": float(info["pipe_clearance"]), "contact": bool(info["pipe_contact"])}
+        )
+    env.close()
+    return {
+        "seed": seed,
+        "pipe_offset_from_plane_m": abs(offset),
+        "edge_corner_to_pipe_m": corner,
+        "reported": reported,
+        "physical": all(
+            row["contact"] == (gap < 0.0) for row, gap in zip(reported, corner, strict=True)
+        ),
+    }
+
+
+def bucket_in_tracks(env_id: str, n: int = 400, seed: int = 0) -> dict[str, Any]:
+    """See the module docstring."""
+    m = machine_from_kwargs(None)
+    box = UNDERCARRIAGE
+    rng = np.random.default_rng(seed)
+    env = gym.make(env_id, max_episode_steps=1)
+    inside = under = reported = 0
+    for q in rng.uniform(m.q_min, m.q_max, size=(n, 4)):
+        _, _, pin, tip = arm_points(*q, m)
+        across = np.array([math.sin(q[0]), -math.cos(q[0]), 0.0]) * 0.5 * m.bucket_width
+        points = [np.array(pin) + s * (np.array(tip) - pin) for s in np.linspace(0, 1, 16)]
+        points += [p + sign * across for p in points for sign in (-1.0, 1.0)]
+        hit = any(
+            abs(p[0]) <= box["half_length"]
+            and abs(p[1]) <= box["half_width"]
+            and 0.0 <= p[2] <= box["height"]
+            for p in points
+        )
+        below = (
+            abs(tip[0]) <= box["half_length"] and abs(tip[1]) <= box["half_width"] and tip[2] < 0
+        )
+        if hit or below:
+            info: dict[str, Any] = {}
+            policy = JointGoals(env.observation_space, env.action_space, [q], m, 0.1)
+            run_episode(
+                env, policy, seed, hook=lambda step, i=info: i.update(step.info), options={"q0": q}
+            )
+            reported += bool(info.get("self_contact", 0.0))
+        inside += hit
+        under += below and not hit
+    env.close()
+    return {
+        "n": n,
+        "bucket_inside_undercarriage": inside / n,
+        "tip_under_tracks": under / n,
+        "reported_as_contact": reported,
+        "physical": reported == inside + under,
+    }
+
+
+def run_probes(env_id: str) -> dict[str, Any]:
+    """Every probe of the module docstring on ``env_id``."""
+    world = _World(env_id)
+    out: dict[str, Any] = {"env_id": env_id}
+    out.update({name: probe(world) for name, probe in PROBES.items()})
+    out["pipe_beside_boom_plane"] = pipe_beside_boom_plane(env_id)
+    out["bucket_in_tracks"] = bucket_in_tracks(env_id)
+    return out

@@ -76,3 +76,7 @@ def test_probes_report_every_issue_probe(results):
     for name in ("heel_first_push", "sideways_swing", "curled_plunge", "boom_into_ground"):
         assert isinstance(probes[name]["physical"], bool), name
     assert probes["dragged_full_bucket"]["full_at_step"] is not None
+    pipe = probes["pipe_beside_boom_plane"]
+    assert pipe["seed"] is not None
+    assert pipe["edge_corner_to_pipe_m"][0] < 0.0 < pipe["edge_corner_to_pipe_m"][1]
+    assert 0.0 < probes["bucket_in_tracks"]["bucket_inside_undercarriage"] < 0.05
