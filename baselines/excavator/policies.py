@@ -1,14 +1,16 @@
 """Scripted reference policies for the excavator: reach, and one dig cycle.
 
 Both act from the observation alone (sliced by name with
-:func:`motiongym.envs.excavator.observation.layout`), rebuild the machine from
-``env_kwargs``, turn bucket poses into joint angles with the Newton-Raphson
+:func:`motiongym.envs.excavator.observation.layout`), rebuild the machine and
+the environment's settings from ``env_kwargs`` over the environment class's
+own defaults (never a copy of them), turn bucket poses into joint angles with the Newton-Raphson
 IK (:mod:`.newton_raphson`, eq. 9-13) and track them with joint rates within
 the hydraulic limits (:mod:`.tracking`).
 """
 
 from __future__ import annotations
 
+import inspect
 import math
 from typing import Any
 
@@ -19,13 +21,27 @@ from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.envs.excavator.config import machine_from_kwargs
+from motiongym.envs.excavator.env import ExcavatorEnv, ExcavatorReachEnv
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
 
 REACHED = 2e-3  # rad: a waypoint counts as reached
 
 
+def env_settings(env_class: type, env_kwargs: dict[str, Any]) -> dict[str, Any]:
+    """The environment's keyword arguments: its class's defaults updated by ``env_kwargs``."""
+    parameters = inspect.signature(env_class.__init__).parameters
+    settings = {
+        name: p.default
+        for name, p in parameters.items()
+        if p.default is not inspect.Parameter.empty
+    }
+    settings.update(env_kwargs)
+    return settings
+
+
 class _ExcavatorPolicy(ScriptedPolicy):
     TASK = "reach"
+    ENV: type = ExcavatorReachEnv
 
     def __init__(
         self,
@@ -34,9 +50,10 @@ class _ExcavatorPolicy(ScriptedPolicy):
         env_kwargs: dict[str, Any] | None = None,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
-        self.m = machine_from_kwargs(self.env_kwargs.get("machine"))
-        self.dt = float(self.env_kwargs.get("dt", 0.1))
-        self.safety = float(self.env_kwargs.get("pipe_safety", 0.5))
+        settings = env_settings(self.ENV, self.env_kwargs)
+        self.m = machine_from_kwargs(settings["machine"])
+        self.dt = float(settings["dt"])
+        self.safety = float(settings["pipe_safety"])
         self.lay = layout(self.TASK)
 
     def _goal(self, wp: bp.Waypoint, q_start: np.ndarray) -> np.ndarray:
@@ -61,6 +78,10 @@ class ReachPolicy(_ExcavatorPolicy):
 
     def new_memory(self) -> dict:
         return {"goals": None, "index": 0}
+
+    def describe(self, memory: dict) -> dict:
+        """``planned`` (the IK goals are set) and ``waypoint`` (0: above, 1: target)."""
+        return {"planned": memory["goals"] is not None, "waypoint": memory["index"]}
 
     def act(self, observation: np.ndarray, memory: dict) -> np.ndarray:
         obs = np.asarray(observation, dtype=np.float64)
@@ -88,6 +109,7 @@ class DigCyclePolicy(_ExcavatorPolicy):
     """
 
     TASK = "dig"
+    ENV = ExcavatorEnv
 
     def new_memory(self) -> dict:
         return {"stage": None, "goals": None, "index": 0, "depth": None}
