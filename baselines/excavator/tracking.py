@@ -77,22 +77,35 @@ def solve_pose(
     m: Machine,
     q_start: np.ndarray | None = None,
     max_iterations: int = 30,
+    base: np.ndarray | None = None,
 ) -> IKResult:
-    """Joint angles for the tip pose, trying NR, projected NR and LM in turn."""
+    """Joint angles for the tip pose, trying NR, projected NR and LM in turn.
+
+    ``tip`` is in the reference frame O; ``base`` is ``H_M^O`` (eq. 1-2, the
+    machine on a slope; default identity), ``beta`` is measured in frame M.
+    """
     tip = np.asarray(tip, float)
+    local = tip if base is None else np.linalg.solve(base, np.append(tip, 1.0))[:3]
     starts = []
     for q in (q_start, m.q_rest, m.q_ready):
         if q is None:
             continue
         q = np.array(q, float)
-        q[0] = swing_for_target(tip[0], tip[1], m)
+        q[0] = swing_for_target(local[0], local[1], m)
         q[3] = beta - q[1] - q[2]  # bucket already at the target angle
         starts.append(q)
     best = None
     for q0 in starts:
         for method, clamp in (("newton", False), ("newton", True), ("lm", True)):
             result = solve(
-                tip, beta, m, q0=q0, method=method, clamp=clamp, max_iterations=max_iterations
+                tip,
+                beta,
+                m,
+                q0=q0,
+                base=base,
+                method=method,
+                clamp=clamp,
+                max_iterations=max_iterations,
             )
             if result.converged:
                 return result

@@ -196,3 +196,15 @@ def test_policies_read_the_environment_settings_not_copies():
     defaults = env_settings(ExcavatorEnv, {})
     plain = gym.make("motiongym/Excavator-v0").unwrapped
     assert (defaults["dt"], defaults["pipe_safety"]) == (plain.dt, plain.pipe_safety)
+
+
+def test_solve_pose_on_a_slope():
+    from motiongym.envs.excavator.kinematics import base_pose
+
+    base = base_pose((0.5, -0.3, 0.2), (0.08, -0.12, 0.3))  # about 8 deg of roll, 7 of pitch
+    rng = np.random.default_rng(9)
+    for q in rng.uniform(np.array(M.q_min) + 0.1, np.array(M.q_max) - 0.1, size=(30, 4)):
+        h = forward(q, M, base)
+        result = solve_pose(h[:3, 3], bucket_angle(q), M, base=base)
+        assert result.converged
+        np.testing.assert_allclose(forward(result.q, M, base)[:3, 3], h[:3, 3], atol=1e-3)
