@@ -33,9 +33,11 @@ different machine is one new instance.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
+
+from motiongym.envs.core import ArgumentError, check_float, check_shape
 
 
 @dataclass(frozen=True)
@@ -71,7 +73,25 @@ class Machine:
     soil_cohesion: float = 10e3  # Pa
     n_gamma: float = 1.5  # weight factor (Reece charts, rake ~45 deg, phi ~30 deg)
     n_c: float = 2.5  # cohesion factor
-    min_speed_fraction: float = 0.05  # the tip never locks completely
+    min_speed_fraction: float = 0.05  # the tip never locks completely (v0 soil only)
+
+    def __post_init__(self) -> None:
+        """Every field checked (``machine.<name>`` in the message); see :data:`LIMITS`."""
+        for f in fields(self):
+            name, value = f"machine.{f.name}", getattr(self, f.name)
+            lo, hi, size = LIMITS[f.name]
+            if size == 0:
+                object.__setattr__(self, f.name, check_float(name, value, lo, hi))
+                continue
+            a = check_shape(name, value, (size,))
+            if not ((a >= lo) & (a <= hi)).all():
+                raise ArgumentError(f"{name} must be {size} numbers in [{lo}, {hi}], got {value!r}")
+            object.__setattr__(self, f.name, tuple(float(v) for v in a))
+        if any(lo >= hi for lo, hi in zip(self.q_min, self.q_max, strict=True)):
+            raise ArgumentError(
+                f"machine.q_min must be below machine.q_max joint by joint, got {self.q_min!r} "
+                f"and {self.q_max!r}"
+            )
 
     @property
     def dh(self) -> np.ndarray:
@@ -110,6 +130,32 @@ class Machine:
         }
 
 
+# (low, high, size) per field: size 0 is a scalar; lengths bounded to keep the
+# machine on the 25 m x 22 m ground map, radii and forces positive.
+LIMITS: dict[str, tuple[float, float, int]] = {
+    "L0": (-5.0, 5.0, 0),
+    "d1": (0.0, 5.0, 0),
+    "L1": (-2.0, 2.0, 0),
+    "d2": (-2.0, 2.0, 0),
+    "L2": (0.5, 10.0, 0),
+    "L3": (0.5, 10.0, 0),
+    "L4": (0.3, 3.0, 0),
+    "q_min": (-math.pi, math.pi, 4),
+    "q_max": (-math.pi, math.pi, 4),
+    "rate_max": (1e-3, 5.0, 4),
+    "q_rest": (-math.pi, math.pi, 4),
+    "q_ready": (-math.pi, math.pi, 4),
+    "link_radius": (0.01, 1.5, 3),
+    "bucket_capacity": (0.05, 10.0, 0),
+    "bucket_width": (0.1, 4.0, 0),
+    "dig_force": (1.0, 1e7, 0),
+    "soil_unit_weight": (1.0, 1e6, 0),
+    "soil_cohesion": (0.0, 1e7, 0),
+    "n_gamma": (0.0, 100.0, 0),
+    "n_c": (0.0, 100.0, 0),
+    "min_speed_fraction": (0.0, 1.0, 0),
+}
+
 DEFAULT_MACHINE = Machine()
 
 
@@ -120,10 +166,11 @@ def machine_from_kwargs(machine: dict | Machine | None) -> Machine:
     if isinstance(machine, Machine):
         return machine
     if not isinstance(machine, dict):
-        raise TypeError(f"machine must be a dict of overrides or a Machine, got {machine!r}")
+        raise ArgumentError(
+            f"machine must be None, a dict of overrides or a Machine, got {machine!r}"
+        )
     valid = set(Machine.__dataclass_fields__)
-    unknown = sorted(set(machine) - valid)
+    unknown = sorted(set(machine) - valid, key=str)
     if unknown:
-        raise ValueError(f"unknown machine parameter(s) {unknown}; valid: {sorted(valid)}")
-    values = {k: tuple(v) if isinstance(v, list) else v for k, v in machine.items()}
-    return Machine(**values)
+        raise ArgumentError(f"unknown machine parameter(s) {unknown}; valid: {sorted(valid)}")
+    return Machine(**machine)

@@ -7,8 +7,7 @@ stick (to the bucket pin) and bucket (pin to cutting edge), with the radii of
 
 * pipe: a capsule of radius ``r`` about a straight segment below the ground
   (a utility located by a locate survey); clearance = segment-segment
-  distance (:func:`segment_distance`, the formulas of
-  :mod:`motiongym.envs.geometry` for one pair) - link radius - ``r``.
+  distance (:func:`motiongym.envs.geometry.segment_distance`) - link radius - ``r``.
 * truck: the body as a box (footprint ``length x width`` turned by ``yaw``,
   from the ground up to the rim height; the open bed is inside it, so a bucket
   must stay above the rim). The segment-box distance is exact, computed in
@@ -30,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-_EPS = 1e-12  # as in motiongym.envs.geometry
+from motiongym.envs.geometry import segment_distance
 
 
 @dataclass(frozen=True)
@@ -92,41 +91,6 @@ class Truck:
         """The box in its own frame (along, across, up): ``(low, high)`` corners (m)."""
         hl, hw = self.half_length, self.half_width
         return (-hl, -hw, 0.0), (hl, hw, self.height)
-
-
-def segment_distance(
-    p0: Sequence[float], p1: Sequence[float], q0: Sequence[float], q1: Sequence[float]
-) -> float:
-    """Distance between the segments ``p0 p1`` and ``q0 q1`` (3D), scalar math.
-
-    The same formulas, in the same order, as
-    :func:`motiongym.envs.geometry.closest_points_between_segments`
-    (Ericson 2005, section 5.1.9, degenerate cases folded in) for one pair:
-    NumPy's per-call overhead dominates on a handful of segments. Equal to it
-    to rounding (tested).
-    """
-    d1 = (p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2])
-    d2 = (q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2])
-    r = (p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2])
-    a = max(d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2], _EPS)
-    e = max(d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2], _EPS)
-    b = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]
-    c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2]
-    f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2]
-    denom = a * e - b * b
-    if denom <= _EPS * a * e:  # parallel: the point of p nearest q0
-        s = -c * e / (a * e)
-    else:
-        s = (b * f - c * e) / denom
-    s = min(max(s, 0.0), 1.0)
-    t = (b * s + f) / e
-    clamped = min(max(t, 0.0), 1.0)
-    if t != clamped:
-        s = min(max((b * clamped - c) / a, 0.0), 1.0)
-    x = r[0] + s * d1[0] - clamped * d2[0]
-    y = r[1] + s * d1[1] - clamped * d2[1]
-    z = r[2] + s * d1[2] - clamped * d2[2]
-    return math.sqrt(x * x + y * y + z * z)
 
 
 def pipe_clearance(

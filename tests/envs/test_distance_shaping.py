@@ -48,12 +48,12 @@ def test_dig_cycle_approach_term_is_progress_toward_the_subgoal_from_zone_to_tru
     truck = world.scene.truck
     goals = []
     for _ in range(600):
-        tip = np.array(world.tip)
+        tip = np.array(world.world.tip)
         action, _ = policy.predict(observation, deterministic=True)
         observation, reward, terminated, truncated, info = env.step(action)
         goal = world.subgoal()
         goals.append(goal)
-        progress = np.linalg.norm(tip - goal) - np.linalg.norm(np.subtract(world.tip, goal))
+        progress = np.linalg.norm(tip - goal) - np.linalg.norm(np.subtract(world.world.tip, goal))
         assert info["reward_approach"] == pytest.approx(0.5 * progress, rel=1e-9, abs=1e-12)
         if terminated or truncated:
             break

@@ -14,7 +14,7 @@ from gymnasium.utils.env_checker import check_env  # noqa: E402
 from stable_baselines3.common.env_checker import check_env as sb3_check_env  # noqa: E402
 
 import motiongym  # noqa: E402, F401
-from motiongym.envs.excavator import base  # noqa: E402
+from motiongym.envs.excavator import world as base  # noqa: E402
 from motiongym.envs.excavator.obstacles import pipe_clearance, truck_clearance  # noqa: E402
 
 IDS = ("motiongym/ExcavatorReach-v0", "motiongym/Excavator-v0")
@@ -67,8 +67,44 @@ def test_bad_input_raises(env_id):
         env.reset(options={"q0": [0.0, 1.0]})
     with pytest.raises(ValueError, match="render_mode"):
         type(env)(render_mode="human")
-    with pytest.raises(TypeError):
+    with pytest.raises(ValueError, match="unknown keyword argument"):
         gym.make(env_id, unknown_weight=1.0)
+    with pytest.raises(ValueError, match="options must be None or a dict"):
+        env.reset(options="notadict")
+    with pytest.raises(ValueError, match="q0"):
+        env.reset(options={"q0": [0.0, np.nan, 0.0, 0.0]})
+
+
+@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"machine": {"L2": -5}}, "machine.L2"),
+        ({"machine": {"q_min": (0.0, 0.0, 0.0, 0.0), "q_max": (0.0, 1.0, 1.0, 1.0)}}, "q_min"),
+        ({"machine": "big"}, "machine"),
+        ({"dt": float("nan")}, "dt"),
+        ({"dt": 0.0}, "dt"),
+        ({"dt": 1e9}, "dt"),
+        ({"time": float("inf")}, "time"),
+        ({"pipe_safety": -1.0}, "pipe_safety"),
+        ({"render_size": (0, 0)}, "render_size"),
+        ({"physics": "v9"}, "physics"),
+        ({"slope": 0.1}, "slope"),  # v0 physics is level
+        ({"physics": "v1", "slope": 2.0}, "slope"),
+    ],
+)
+def test_bad_keyword_arguments_name_the_argument(env_id, kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        gym.make(env_id, **kwargs)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_step_and_render_before_reset_are_a_clear_error(env_id):
+    env = gym.make(env_id, render_mode="rgb_array").unwrapped
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros(4))
+    with pytest.raises(RuntimeError, match="reset"):
+        env.render()
 
 
 @pytest.mark.parametrize("env_id", IDS)
@@ -93,12 +129,12 @@ def test_reported_clearances_are_exact_near_and_lower_bounds_far():
     for seed in range(30):
         env.reset(seed=seed)
         for _ in range(40):
-            env.q = list(rng.uniform(m.q_min, m.q_max))
-            env._forward()
-            env._clearances()
-            pipe = pipe_clearance(env.points, m.link_radius, env.pipe)
-            truck = truck_clearance(env.points, m.link_radius, env.truck)
-            for got, exact in ((env.pipe_clear, pipe), (env.truck_clear, truck)):
+            env.world.q = list(rng.uniform(m.q_min, m.q_max))
+            env.world._forward()
+            env.world._clearances()
+            pipe = pipe_clearance(env.world.points, m.link_radius, env.world.pipe)
+            truck = truck_clearance(env.world.points, m.link_radius, env.world.truck)
+            for got, exact in ((env.world.pipe_clear, pipe), (env.world.truck_clear, truck)):
                 if exact < base.HORIZON:
                     assert got == pytest.approx(exact, abs=1e-9)
                 else:
@@ -113,42 +149,42 @@ def test_digging_fills_the_bucket_slows_the_arm_and_pouring_spills():
     env.reset(seed=seed)
     zone = env.scene.zone
     tip = np.array([np.cos(zone.azimuth), np.sin(zone.azimuth), 0.0]) * zone.r_far
-    tip[2] = env.terrain.height_at(tip[0], tip[1]) + 0.05
+    tip[2] = env.world.terrain.height_at(tip[0], tip[1]) + 0.05
     q0 = next(s for s in analytic_solutions(tip, -1.6, env.m) if within_limits(s, env.m))
     env.reset(seed=seed, options={"q0": q0})
-    volume0 = env.terrain.volume()
+    volume0 = env.world.terrain.volume()
     rates = []
     for _ in range(8):  # boom down: the bucket enters the ground
         _, _, terminated, _, info = env.step(np.array([0.0, -0.15, 0.0, 0.0]))
-        rates.append(abs(env.qdot[1]) / (0.15 * env.m.rate_max[1]))
+        rates.append(abs(env.world.qdot[1]) / (0.15 * env.m.rate_max[1]))
         assert not terminated
-    t = env.terrain
-    i, j = int((env.tip[0] - t.x0) / t.cell), int((env.tip[1] - t.y0) / t.cell)
-    assert env.scene.heights[i, j] - env.tip[2] > 0.3  # below the original surface
+    t = env.world.terrain
+    i, j = int((env.world.tip[0] - t.x0) / t.cell), int((env.world.tip[1] - t.y0) / t.cell)
+    assert env.scene.heights[i, j] - env.world.tip[2] > 0.3  # below the original surface
     assert rates[0] == 1.0 and min(rates) < 0.9  # slowed by the soil
     for _ in range(15):  # stick in: drag toward the machine
         _, _, terminated, _, info = env.step(np.array([0.0, 0.0, -0.5, -0.2]))
         assert not terminated
     assert info["bucket_fill"] > 0.1
-    assert volume0 - env.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
+    assert volume0 - env.world.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
     assert info["outside_zone"] < 0.05 * info["bucket_fill"]  # dug along the marked strip
     # Lift and open the bucket away from the truck: the soil is spilled on the ground.
     for _ in range(40):
         _, _, _, _, info = env.step(np.array([0.0, 1.0, 0.0, 1.0]))
     assert info["spill"] > 0.0 and info["truck_soil"] == 0.0
     assert info["spill"] + info["bucket_fill"] == pytest.approx(info["dig_fill"], abs=1e-9)
-    assert volume0 - env.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
+    assert volume0 - env.world.terrain.volume() == pytest.approx(info["bucket_fill"], abs=1e-9)
 
 
 def test_joint_limits_hold_and_rates_are_the_hydraulic_limits():
     env = gym.make("motiongym/ExcavatorReach-v0").unwrapped
     env.reset(seed=0)
     _, _, _, _, _ = env.step(np.ones(4))
-    assert env.qdot == pytest.approx(list(env.m.rate_max))
+    assert env.world.qdot == pytest.approx(list(env.m.rate_max))
     for _ in range(100):
         env.step(np.ones(4))
-    assert env.q[1] == pytest.approx(env.m.q_max[1])
-    assert env.qdot[1] == 0.0
+    assert env.world.q[1] == pytest.approx(env.m.q_max[1])
+    assert env.world.qdot[1] == 0.0
 
 
 def test_reach_success_terminates_with_the_bonus():
@@ -156,14 +192,14 @@ def test_reach_success_terminates_with_the_bonus():
 
     env = gym.make("motiongym/ExcavatorReach-v0").unwrapped
     _, info = env.reset(seed=1)
-    assert info["position_error"] > env.tolerance_position and not info["is_success"]
+    assert info["position_error"] > env.params.tolerance_position and not info["is_success"]
     target = env.scene.target
     q = next(s for s in analytic_solutions(target[:3], target[3], env.m) if within_limits(s, env.m))
     env.reset(seed=1, options={"q0": q})
     _, reward, terminated, _, info = env.step(np.zeros(4))
     assert terminated and info["is_success"]
     assert info["position_error"] < 1e-9 and info["angle_error"] < 1e-9
-    assert info["reward_success"] == env.weights["success"]
+    assert info["reward_success"] == env.params.weights["success"]
 
 
 @pytest.mark.parametrize("env_id, task", [(IDS[0], "reach"), (IDS[1], "dig")])
@@ -177,18 +213,20 @@ def test_observation_slices_match_the_state(env_id, task):
         obs, *_ = env.step(rng.uniform(-1, 1, 4))
     lay = layout(task)
     assert obs.shape == env.observation_space.shape and obs.dtype == np.float32
-    np.testing.assert_allclose(obs[lay["q"]], env.q, atol=1e-6)
-    np.testing.assert_allclose(obs[lay["qdot"]], env.qdot, atol=1e-6)
-    np.testing.assert_allclose(obs[lay["tip"]], env.tip, atol=1e-5)
-    assert obs[lay["bucket"]][0] == pytest.approx(env.beta, abs=1e-6)
-    np.testing.assert_allclose(obs[lay["truck"]], env.truck.as_array(), atol=1e-5)
-    np.testing.assert_allclose(obs[lay["pipe"]], env.pipe.as_array(), atol=1e-5)
-    c, s = np.cos(env.q[0]), np.sin(env.q[0])
+    np.testing.assert_allclose(obs[lay["q"]], env.world.q, atol=1e-6)
+    np.testing.assert_allclose(obs[lay["qdot"]], env.world.qdot, atol=1e-6)
+    np.testing.assert_allclose(obs[lay["tip"]], env.world.tip, atol=1e-5)
+    assert obs[lay["bucket"]][0] == pytest.approx(env.world.beta, abs=1e-6)
+    np.testing.assert_allclose(obs[lay["truck"]], env.world.truck.as_array(), atol=1e-5)
+    np.testing.assert_allclose(obs[lay["pipe"]], env.world.pipe.as_array(), atol=1e-5)
+    c, s = np.cos(env.world.q[0]), np.sin(env.world.q[0])
     r = 1.0 + 0.4 * np.arange(24)
-    np.testing.assert_allclose(obs[lay["profile"]], env.terrain.heights_at(c * r, s * r), atol=0.2)
+    np.testing.assert_allclose(
+        obs[lay["profile"]], env.world.terrain.heights_at(c * r, s * r), atol=0.2
+    )
     if task == "dig":
         np.testing.assert_allclose(obs[lay["zone"]], env.scene.zone.as_array(), atol=1e-5)
-        assert obs[lay["truck_soil"]][0] == pytest.approx(env.truck_soil)
+        assert obs[lay["truck_soil"]][0] == pytest.approx(env.world.truck_soil)
     else:
         np.testing.assert_allclose(obs[lay["target"]], env.scene.target, atol=1e-5)
 
@@ -201,7 +239,7 @@ def test_digging_beside_the_zone_is_reported():
     zone = env.scene.zone
     azimuth = zone.azimuth + 0.6  # well beside the strip
     tip = np.array([np.cos(azimuth), np.sin(azimuth), 0.0]) * zone.r_far
-    tip[2] = env.terrain.height_at(tip[0], tip[1]) + 0.05
+    tip[2] = env.world.terrain.height_at(tip[0], tip[1]) + 0.05
     q0 = next(s for s in analytic_solutions(tip, -1.6, env.m) if within_limits(s, env.m))
     env.reset(seed=4, options={"q0": q0})
     for _ in range(8):

@@ -14,24 +14,26 @@ import pytest  # noqa: E402
 from motiongym.envs.excavator import kinematics as kin  # noqa: E402
 from motiongym.envs.excavator.config import DEFAULT_MACHINE as M  # noqa: E402
 from motiongym.envs.excavator.config import Machine, machine_from_kwargs  # noqa: E402
-from motiongym.envs.excavator.model import build_model  # noqa: E402
 from motiongym.envs.excavator.obstacles import (  # noqa: E402
     Pipe,
     Truck,
     pipe_clearance,
     segment_box_distance,
-    segment_distance,
     truck_clearance,
 )
-from motiongym.envs.excavator.soil import Terrain, cutting_force, speed_fraction  # noqa: E402
-from motiongym.envs.excavator.task import (  # noqa: E402
+from motiongym.envs.excavator.render_scene import build_model  # noqa: E402
+from motiongym.envs.excavator.scenes import (  # noqa: E402
     GRID_CELL,
     GRID_ORIGIN,
     GRID_SHAPE,
     ZONE_MARGIN,
     DigZone,
 )
-from motiongym.envs.geometry import closest_points_between_segments  # noqa: E402
+from motiongym.envs.excavator.soil import Terrain, cutting_force, speed_fraction  # noqa: E402
+from motiongym.envs.geometry import (
+    closest_points_between_segments,  # noqa: E402
+    segment_distance,  # noqa: E402
+)
 
 
 def _rot(axis: str, a: float) -> np.ndarray:

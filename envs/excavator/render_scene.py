@@ -1,4 +1,4 @@
-"""The MuJoCo model of the excavator, built in code from the same DH table.
+"""The render scene: the excavator as a MuJoCo model built from the same DH table.
 
 :func:`build_spec` turns each row of Table 1 (Craig's modified DH,
 ``T_i^{i-1} = RotX(alpha_{i-1}) TransX(a_{i-1}) RotZ(theta_i) TransZ(d_i)``)
@@ -23,10 +23,10 @@ import mujoco  # noqa: E402
 import numpy as np
 
 from motiongym.envs.excavator.config import Machine
-from motiongym.envs.excavator.task import GRID_CELL, GRID_ORIGIN, GRID_SHAPE
+from motiongym.envs.excavator.scenes import GRID_CELL, GRID_ORIGIN, GRID_SHAPE
 
 if TYPE_CHECKING:  # pragma: no cover
-    from motiongym.envs.excavator.base import ExcavatorBase
+    from motiongym.envs.excavator.world import ExcavatorWorld
 
 Z_MIN, Z_MAX = -4.0, 3.0  # m: height-field range
 JOINTS = ("swing", "boom", "stick", "bucket")
@@ -128,16 +128,17 @@ class SceneRenderer:
     def _geom(self, name: str) -> int:
         return self.model.geom(name).id
 
-    def render(self, env: ExcavatorBase) -> np.ndarray:
+    def render(self, world: ExcavatorWorld) -> np.ndarray:
+        """A frame of the world's state (an :class:`ExcavatorWorld` or its v1 twin)."""
         model, data = self.model, self.data
-        data.qpos[:4] = env.q
-        key = (id(env.terrain), env.terrain.version)
+        data.qpos[:4] = world.q
+        key = (id(world.terrain), world.terrain.version)
         if key != self._terrain_key:
-            levels = np.clip((env.terrain.h.T - Z_MIN) / (Z_MAX - Z_MIN), 0.0, 1.0)
+            levels = np.clip((world.terrain.h.T - Z_MIN) / (Z_MAX - Z_MIN), 0.0, 1.0)
             model.hfield_data[:] = levels.reshape(-1)
             mujoco.mjr_uploadHField(model, self.renderer._mjr_context, self._hfield)
             self._terrain_key = key
-        pipe, truck = env.pipe, env.truck
+        pipe, truck = world.pipe, world.truck
         g = self._geom("pipe")
         a, b = np.array(pipe.a), np.array(pipe.b)
         model.geom_pos[g] = 0.5 * (a + b)
@@ -148,23 +149,27 @@ class SceneRenderer:
         model.geom_size[g] = [truck.half_length, truck.half_width, truck.height / 2]
         model.geom_quat[g] = _quat_z(truck.yaw)
         g = self._geom("truck_soil")
-        fill_height = env.truck_soil / (4 * 2.4 * 1.1) + 0.01
+        fill_height = world.truck_soil / (4 * 2.4 * 1.1) + 0.01
         model.geom_pos[g] = [truck.cx, truck.cy, truck.height - 1.3 + fill_height]
         model.geom_size[g, 2] = fill_height
         model.geom_quat[g] = _quat_z(truck.yaw)
         g = self._geom("bucket_soil")
-        model.geom_size[g, 0] = 0.01 + 0.6 * (env.fill / env.m.bucket_capacity) ** (1 / 3)
-        zone = getattr(env.scene, "zone", None)
+        model.geom_size[g, 0] = 0.01 + 0.6 * (world.fill / world.m.bucket_capacity) ** (1 / 3)
+        zone = getattr(world.scene, "zone", None)
         g = self._geom("zone")
         if zone is not None:
             mid = 0.5 * (zone.r_near + zone.r_far)
             c, s = math.cos(zone.azimuth), math.sin(zone.azimuth)
-            model.geom_pos[g] = [c * mid, s * mid, env.terrain.height_at(c * mid, s * mid) + 0.05]
-            model.geom_size[g] = [0.5 * (zone.r_far - zone.r_near), 0.5 * env.m.bucket_width, 0.01]
+            model.geom_pos[g] = [c * mid, s * mid, world.terrain.height_at(c * mid, s * mid) + 0.05]
+            model.geom_size[g] = [
+                0.5 * (zone.r_far - zone.r_near),
+                0.5 * world.m.bucket_width,
+                0.01,
+            ]
             model.geom_quat[g] = _quat_z(zone.azimuth)
         else:
             model.geom_pos[g] = [0, 0, -10]
-        target = getattr(env.scene, "target", None)
+        target = getattr(world.scene, "target", None)
         if target is not None:
             model.site_pos[model.site("target").id] = target[:3]
         mujoco.mj_kinematics(model, data)
