@@ -44,7 +44,6 @@ import numpy as np
 from motiongym.agents.evaluate import run_episode
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.excavator.config import machine_from_kwargs
 from motiongym.envs.excavator.kinematics import arm_points
 from motiongym.envs.excavator.observation import layout
 
@@ -87,14 +86,14 @@ class _World:
         self.env_id, self.seed = env_id, seed
         env = gym.make(env_id)
         obs, _ = env.reset(seed=seed)
-        self.m = machine_from_kwargs(None)
-        self.dt = float(env.unwrapped.dt)
+        self.m = env.unwrapped.params.machine
+        self.dt = float(env.unwrapped.params.dt)
         lay = layout("dig")
         truck = obs[lay["truck"]]
         self.azimuth = -math.copysign(math.pi / 2, float(truck[1]))  # away from the truck
-        self.heights0 = np.array(env.unwrapped.terrain.h)
-        self.cell = float(env.unwrapped.terrain.cell)
-        self.surface = env.unwrapped.terrain.height_at
+        terrain = env.unwrapped.world.terrain
+        self.cell = float(terrain.cell)
+        self.surface = terrain.height_at
         self.space = (env.observation_space, env.action_space)
         env.close()
 
@@ -130,7 +129,7 @@ class _World:
                     "pipe_contact": float(step.info["pipe_contact"]),
                 }
             )
-            heights.append(np.array(world.terrain.h))
+            heights.append(np.array(world.world.terrain.h))
 
         episode = run_episode(env, policy, self.seed, hook=hook, options={"q0": np.asarray(q0)})
         env.close()
@@ -269,8 +268,8 @@ def _edge_to_axis(tip, swing: float, half: float, a, b) -> float:
 
 def pipe_beside_boom_plane(env_id: str, seeds=range(400)) -> dict[str, Any]:
     """See the module docstring; the first seed whose pipe fits is used."""
-    m = machine_from_kwargs(None)
     env = gym.make(env_id, max_episode_steps=1)
+    m = env.unwrapped.params.machine
     lay = layout("dig")
     for seed in seeds:
         obs, _ = env.reset(seed=seed)
@@ -320,10 +319,10 @@ def pipe_beside_boom_plane(env_id: str, seeds=range(400)) -> dict[str, Any]:
 
 def bucket_in_tracks(env_id: str, n: int = 400, seed: int = 0) -> dict[str, Any]:
     """See the module docstring."""
-    m = machine_from_kwargs(None)
     box = UNDERCARRIAGE
     rng = np.random.default_rng(seed)
     env = gym.make(env_id, max_episode_steps=1)
+    m = env.unwrapped.params.machine
     inside = under = reported = 0
     for q in rng.uniform(m.q_min, m.q_max, size=(n, 4)):
         _, _, pin, tip = arm_points(*q, m)

@@ -1,16 +1,17 @@
 """Scripted reference policies for the excavator: reach, and one dig cycle.
 
 Both act from the observation alone (sliced by name with
-:func:`motiongym.envs.excavator.observation.layout`), rebuild the machine and
-the environment's settings from ``env_kwargs`` over the environment class's
-own defaults (never a copy of them), turn bucket poses into joint angles with the Newton-Raphson
-IK (:mod:`.newton_raphson`, eq. 9-13) and track them with joint rates within
-the hydraulic limits (:mod:`.tracking`).
+:func:`motiongym.envs.excavator.observation.layout`), build the environment's
+parameters from ``env_kwargs`` as the environment does
+(:func:`motiongym.envs.excavator.params.params_for`: the machine, the step,
+the safety distance, the physics; no default copied), turn bucket poses into
+joint angles with the Newton-Raphson IK (:mod:`.newton_raphson`, eq. 9-13)
+and track them with joint rates within the hydraulic limits
+(:mod:`.tracking`).
 """
 
 from __future__ import annotations
 
-import inspect
 import math
 from typing import Any
 
@@ -20,28 +21,14 @@ from gymnasium import spaces
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.excavator.config import machine_from_kwargs
-from motiongym.envs.excavator.env import ExcavatorEnv, ExcavatorReachEnv
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
+from motiongym.envs.excavator.params import params_for
 
 REACHED = 2e-3  # rad: a waypoint counts as reached
 
 
-def env_settings(env_class: type, env_kwargs: dict[str, Any]) -> dict[str, Any]:
-    """The environment's keyword arguments: its class's defaults updated by ``env_kwargs``."""
-    parameters = inspect.signature(env_class.__init__).parameters
-    settings = {
-        name: p.default
-        for name, p in parameters.items()
-        if p.default is not inspect.Parameter.empty
-    }
-    settings.update(env_kwargs)
-    return settings
-
-
 class _ExcavatorPolicy(ScriptedPolicy):
     TASK = "reach"
-    ENV: type = ExcavatorReachEnv
 
     def __init__(
         self,
@@ -50,11 +37,11 @@ class _ExcavatorPolicy(ScriptedPolicy):
         env_kwargs: dict[str, Any] | None = None,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
-        settings = env_settings(self.ENV, self.env_kwargs)
-        self.m = machine_from_kwargs(settings["machine"])
-        self.dt = float(settings["dt"])
-        self.safety = float(settings["pipe_safety"])
-        self.lay = layout(self.TASK)
+        self.params = params_for(self.TASK, self.env_kwargs)
+        self.m = self.params.machine
+        self.dt = self.params.dt
+        self.safety = self.params.pipe_safety
+        self.lay = layout(self.TASK, self.params.physics)
 
     def _goal(self, wp: bp.Waypoint, q_start: np.ndarray) -> np.ndarray:
         result = solve_pose(np.array(wp.tip), wp.beta, self.m, q_start)
@@ -109,7 +96,6 @@ class DigCyclePolicy(_ExcavatorPolicy):
     """
 
     TASK = "dig"
-    ENV = ExcavatorEnv
 
     def new_memory(self) -> dict:
         return {"stage": None, "goals": None, "index": 0, "depth": None}

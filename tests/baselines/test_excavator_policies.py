@@ -184,18 +184,15 @@ def test_the_bucket_cuts_only_with_its_opening_ahead():
     assert worst > 0.3  # never heel first or sideways: within 73 deg of the opening
 
 
-def test_policies_read_the_environment_settings_not_copies():
-    from motiongym.baselines.excavator.policies import DigCyclePolicy, env_settings
-    from motiongym.envs.excavator.env import ExcavatorEnv
+def test_policies_read_the_environment_parameters_not_copies():
+    from motiongym.baselines.excavator.policies import DigCyclePolicy
 
-    env = gym.make("motiongym/Excavator-v0", dt=0.05, pipe_safety=0.7)
-    policy = DigCyclePolicy(
-        env.observation_space, env.action_space, {"dt": 0.05, "pipe_safety": 0.7}
-    )
-    assert (policy.dt, policy.safety) == (0.05, 0.7)
-    defaults = env_settings(ExcavatorEnv, {})
-    plain = gym.make("motiongym/Excavator-v0").unwrapped
-    assert (defaults["dt"], defaults["pipe_safety"]) == (plain.dt, plain.pipe_safety)
+    kwargs = {"dt": 0.05, "pipe_safety": 0.7, "machine": {"L3": 3.1}}
+    env = gym.make("motiongym/Excavator-v0", **kwargs)
+    policy = DigCyclePolicy(env.observation_space, env.action_space, kwargs)
+    assert policy.params == env.unwrapped.params
+    plain = DigCyclePolicy(env.observation_space, env.action_space, {})
+    assert (plain.dt, plain.safety) == (gym.make("motiongym/Excavator-v0").unwrapped.dt, 0.5)
 
 
 def test_solve_pose_on_a_slope():
