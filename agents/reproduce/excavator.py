@@ -88,11 +88,15 @@ def dig_cycles(n: int, env_id: str = DIG_ID) -> dict[str, Any]:
     """
     import gymnasium as gym
 
+    from motiongym.agents.environments import resolved_env_kwargs
     from motiongym.agents.evaluate import run_episode
     from motiongym.baselines.registry import make_policy
 
     env = gym.make(env_id)
-    policy = _TimedPolicy(make_policy(env_id, "dig-cycle", env.observation_space, env.action_space))
+    kwargs = resolved_env_kwargs(env_id, None)
+    policy = _TimedPolicy(
+        make_policy(env_id, "dig-cycle", env.observation_space, env.action_space, kwargs)
+    )
     zone = layout("dig")["zone"]
     rows = []
     for seed in range(n):
