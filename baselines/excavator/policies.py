@@ -48,14 +48,23 @@ class _ExcavatorPolicy(ScriptedPolicy):
         # A pose beyond the limits is tracked as far as the joints go.
         return np.clip(result.q, self.m.q_min, self.m.q_max)
 
-    def _follow(self, q: np.ndarray, memory: dict) -> np.ndarray:
-        """Track the memory's joint goals in order; hold the last one."""
+    def _follow(self, obs: np.ndarray, memory: dict) -> np.ndarray:
+        """Track the memory's joint goals in order; hold the last one.
+
+        Under physics v1 the tracking also respects the acceleration limits
+        (from the observed rates) and the shared pump flow.
+        """
+        q = obs[self.lay["q"]]
         goals = memory["goals"]
         while memory["index"] < len(goals) - 1 and np.max(
             np.abs(goals[memory["index"]] - q)
         ) < memory.get("tolerance", REACHED):
             memory["index"] += 1
-        return track(q, goals[memory["index"]], self.m, self.dt)
+        goal = goals[memory["index"]]
+        if self.params.physics == "v0":
+            return track(q, goal, self.m, self.dt)
+        qdot = obs[self.lay["qdot"]]
+        return track(q, goal, self.m, self.dt, qdot, self.m.accel_max, self.m.pump_share)
 
 
 class ReachPolicy(_ExcavatorPolicy):
@@ -81,7 +90,7 @@ class ReachPolicy(_ExcavatorPolicy):
             q_target = self._goal(bp.Waypoint("target", tuple(tip), beta), q_above)
             memory["goals"] = [q_above, q_target]
             memory["tolerance"] = 0.05
-        return self._follow(q, memory)
+        return self._follow(obs, memory)
 
 
 class DigCyclePolicy(_ExcavatorPolicy):
@@ -147,7 +156,7 @@ class DigCyclePolicy(_ExcavatorPolicy):
         elif stage == "lift" and self._done(q, memory):
             waypoints, _ = bp.carry_dump_path(azimuth, obs[self.lay["truck"]], self.m)
             self._set(memory, "dump", waypoints, q)
-        return self._follow(q, memory)
+        return self._follow(obs, memory)
 
 
 def _flat(r: float) -> float:

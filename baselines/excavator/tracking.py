@@ -10,7 +10,10 @@ speed of the slowest one) with the largest ``lambda`` that keeps
 * with acceleration limits ``accel_max`` (rad/s2): every joint able to stop
   at the goal in steps of ``dt`` (``v^2 / (2 a) + v dt / 2 <= |e|``), and
   each rate within ``accel_max_j dt`` of the current one (the observed
-  ``qdot``).
+  ``qdot``);
+* with a shared pump (``pump_share``: the fraction of the pump's flow a
+  function draws at full rate), the demand ``sum_j |v_j| / rate_max_j
+  share_j`` at most 1, so that the pump never scales the rates itself.
 
 Actions are fractions of ``rate_max``, the environments' action convention.
 Without acceleration limits this is ``a = (q* - q) / (rate_max dt)`` scaled
@@ -44,16 +47,20 @@ def track(
     dt: float,
     qdot: np.ndarray | None = None,
     accel_max: np.ndarray | None = None,
+    pump_share: np.ndarray | None = None,
 ) -> np.ndarray:
     """Normalised joint-rate action (4,) toward ``q_goal`` (synchronised, dead-beat).
 
     ``accel_max`` (4,) rad/s2, with the current rates ``qdot`` (4,): brake in
     time for the goal and change no rate by more than ``accel_max dt``.
+    ``pump_share`` (4,): keep the pump's demand at most 1.
     """
     rate_max = np.array(m.rate_max)
     error = np.asarray(q_goal, float) - np.asarray(q, float)
     raw = error / (rate_max * dt)
     scale = max(1.0, float(np.max(np.abs(raw))))
+    if pump_share is not None:
+        scale = max(scale, float(np.sum(np.abs(raw) * np.asarray(pump_share, float))))
     if accel_max is None:
         return (raw / scale).astype(np.float32)
     accel = np.asarray(accel_max, float)

@@ -205,3 +205,14 @@ def test_solve_pose_on_a_slope():
         result = solve_pose(h[:3, 3], bucket_angle(q), M, base=base)
         assert result.converged
         np.testing.assert_allclose(forward(result.q, M, base)[:3, 3], h[:3, 3], atol=1e-3)
+
+
+def test_tracking_keeps_the_shared_pump_within_its_flow():
+    share = np.array([0.45, 0.95, 0.95, 0.45])
+    goal = np.array([0.8, 0.5, -0.6, 0.9])
+    a = track(np.zeros(4), goal, M, 0.1, pump_share=share)
+    assert np.sum(np.abs(a) * share) == pytest.approx(1.0)
+    step = a * np.array(M.rate_max)
+    assert step / np.linalg.norm(step) == pytest.approx(goal / np.linalg.norm(goal))
+    # Ablation: without it all four at once ask for 2.8 times the pump's flow.
+    assert np.sum(np.abs(track(np.zeros(4), goal, M, 0.1)) * share) > 1.5
