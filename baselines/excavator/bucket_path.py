@@ -50,6 +50,45 @@ DRAG_STEP = 0.25  # m
 
 
 @dataclass(frozen=True)
+class Style:
+    """How the bucket enters and leaves the soil (one per physics).
+
+    ``penetration_angle``: None for the v0 entry (straight from 0.3 m above
+    the far end to the cut depth 0.4 m inside it: a steep plunge), else the
+    descent (rad below horizontal) of a ramp from the surface at the far end
+    to the cut depth. ``beta_open``: bucket angle while entering.
+    ``r_stop``: the drag ends no nearer the swing axis than this (m).
+    ``curl_rise``: the pin rises this much while the bucket curls (m).
+    ``lift_inwards``: the pin moves this much toward the machine while lifting (m).
+    """
+
+    penetration_angle: float | None = None
+    beta_open: float = -1.4
+    r_stop: float = 0.0
+    curl_rise: float = 0.0
+    lift_inwards: float = 0.5
+
+
+V0_STYLE = Style()
+# Physics v1: a bucket's shell may not go deeper into the ground than it is, and
+# only the edge moving within 60 deg of the opening cuts. Entering on a 25 deg
+# ramp with the teeth turned out (beta -1.35: the opening 13 deg below the
+# horizontal, short of pouring at 17 deg; the shell's underside 0.34 m above
+# the edge and 0.49 m behind it, a 35 deg slope) keeps the shell over the ramp
+# the edge has cut; the pin rises while the
+# bucket curls (the shell swings down about the pin otherwise); the drag stops
+# where the curled bucket (its tip 1 m nearer the machine) stays clear of the
+# tracks' front (2.25 m) by 1 m.
+V1_STYLE = Style(
+    penetration_angle=math.radians(25.0),
+    beta_open=-1.35,
+    r_stop=4.3,
+    curl_rise=0.5,
+    lift_inwards=0.0,
+)
+
+
+@dataclass(frozen=True)
 class Waypoint:
     """A bucket pose along the cycle."""
 
@@ -88,37 +127,51 @@ def dig_path(
     r_far: float,
     depth: float,
     surface,
+    style: Style = V0_STYLE,
 ) -> list[Waypoint]:
-    """Approach, penetrate, drag and curl waypoints along the ray at ``azimuth``.
+    """Approach, penetrate and drag waypoints along the ray at ``azimuth``.
 
     ``surface(r)`` gives the ground height at radius ``r`` on that ray (m).
     """
     c, s = math.cos(azimuth), math.sin(azimuth)
+    b_open = style.beta_open
 
     def at(r: float, z: float) -> tuple[float, float, float]:
         return (c * r, s * r, z)
 
-    start = r_far - 0.4
     path = [
-        Waypoint("approach", at(r_far, surface(r_far) + 2.0), BETA_OPEN),
-        Waypoint("approach", at(r_far, surface(r_far) + 0.3), BETA_OPEN),
-        Waypoint("penetrate", at(start, surface(start) - depth), BETA_OPEN),
+        Waypoint("approach", at(r_far, surface(r_far) + 2.0), b_open),
+        Waypoint("approach", at(r_far, surface(r_far) + 0.3), b_open),
     ]
-    n = max(int(math.ceil((start - r_near) / DRAG_STEP)), 1)
+    if style.penetration_angle is None:
+        start = r_far - 0.4
+        path.append(Waypoint("penetrate", at(start, surface(start) - depth), b_open))
+    else:
+        run = depth / math.tan(style.penetration_angle)
+        start = r_far - run
+        n = max(int(math.ceil(math.hypot(run, depth) / DRAG_STEP)), 1)
+        for k in range(1, n + 1):
+            r = r_far - run * k / n
+            path.append(Waypoint("penetrate", at(r, surface(r) - depth * k / n), b_open))
+    end = max(r_near, style.r_stop)
+    n = max(int(math.ceil((start - end) / DRAG_STEP)), 1)
     for k in range(1, n + 1):
-        r = start - (start - r_near) * k / n
-        beta = BETA_OPEN + (BETA_DRAG - BETA_OPEN) * k / n
+        r = start - (start - end) * k / n
+        beta = b_open + (BETA_DRAG - b_open) * k / n
         path.append(Waypoint("drag", at(r, surface(r) - depth), beta))
     return path
 
 
-def curl_lift_path(tip: np.ndarray, beta: float, surface_here: float, m: Machine) -> list[Waypoint]:
-    """Curl about the bucket pin, then lift the pin 0.5 m inwards and up.
+def curl_lift_path(
+    tip: np.ndarray, beta: float, surface_here: float, m: Machine, style: Style = V0_STYLE
+) -> list[Waypoint]:
+    """Curl about the bucket pin, then lift the pin (``style``: inwards) and up.
 
-    The pin (``tip - L4 [cos beta, sin beta]`` in the boom plane) stays put
-    while the bucket turns to ``beta_carry`` (the policy clips joint goals to
-    the joint ranges); then it moves 0.5 m toward the machine and up until
-    the tip is 0.8 m above the surface.
+    The pin (``tip - L4 [cos beta, sin beta]`` in the boom plane) rises
+    ``style.curl_rise`` while the bucket turns to ``beta_carry`` (the policy
+    clips joint goals to the joint ranges); then it moves
+    ``style.lift_inwards`` toward the machine and up until the tip is 0.8 m
+    above the surface.
     """
     x, y, z = (float(v) for v in tip)
     r = math.hypot(x, y)
@@ -130,10 +183,11 @@ def curl_lift_path(tip: np.ndarray, beta: float, surface_here: float, m: Machine
         tr = pr + m.L4 * math.cos(b)
         return (c * tr, s * tr, pz + m.L4 * math.sin(b))
 
-    lift_r = pin_r - 0.5
-    lift_z = max(pin_z + 0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY))
+    curl_z = pin_z + style.curl_rise
+    lift_r = pin_r - style.lift_inwards
+    lift_z = max(curl_z + 0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY))
     return [
-        Waypoint("curl", tip_at(pin_r, pin_z, BETA_CARRY), BETA_CARRY),
+        Waypoint("curl", tip_at(pin_r, curl_z, BETA_CARRY), BETA_CARRY),
         Waypoint("lift", tip_at(lift_r, lift_z, BETA_CARRY), BETA_CARRY),
     ]
 

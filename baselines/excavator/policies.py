@@ -21,6 +21,7 @@ from gymnasium import spaces
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.envs.excavator.kinematics import base_rotation
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
 from motiongym.envs.excavator.params import params_for
 
@@ -106,6 +107,10 @@ class DigCyclePolicy(_ExcavatorPolicy):
 
     TASK = "dig"
 
+    def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
+        super().__init__(observation_space, action_space, env_kwargs)
+        self.style = bp.V1_STYLE if self.params.physics == "v1" else bp.V0_STYLE
+
     def new_memory(self) -> dict:
         return {"stage": None, "goals": None, "index": 0, "depth": None}
 
@@ -126,35 +131,85 @@ class DigCyclePolicy(_ExcavatorPolicy):
             np.max(np.abs(memory["goals"][-1] - q)) < REACHED
         )
 
+    def _scene(self, obs: np.ndarray) -> dict:
+        """The zone, truck and pipe in the base frame M (the observation is in frame O).
+
+        On a slope (v1's ``base`` roll and pitch, the paper's ``H_M^O``) every
+        position is turned by ``R^T``: in frame M the tracks' ground plane is
+        level, and the plan of v0 applies. The truck's rim is its highest
+        corner in frame M.
+        """
+        rot = np.eye(3)
+        if "base" in self.lay:
+            roll, pitch = (float(v) for v in obs[self.lay["base"]])
+            rot = base_rotation(roll, pitch, 0.0)
+        gx, gy = -rot[0, 2] / rot[2, 2], -rot[1, 2] / rot[2, 2]  # the tracks' plane in O
+
+        def to_m(x: float, y: float, z: float | None = None) -> np.ndarray:
+            return rot.T @ np.array([x, y, gx * x + gy * y if z is None else z])
+
+        zone = obs[self.lay["zone"]].copy()
+        zone[0:2], zone[2:4] = to_m(*zone[0:2])[:2], to_m(*zone[2:4])[:2]
+        truck = obs[self.lay["truck"]].copy()
+        cx, cy, yaw, hl, hw, rim = (float(v) for v in truck)
+        c, s = math.cos(yaw), math.sin(yaw)
+        corners = [
+            to_m(cx + c * a - s * b, cy + s * a + c * b, rim) for a in (-hl, hl) for b in (-hw, hw)
+        ]
+        truck[0:2] = to_m(cx, cy, rim)[:2]
+        truck[5] = max(p[2] for p in corners)
+        pipe = obs[self.lay["pipe"]].copy()
+        pipe[0:3], pipe[3:6] = to_m(*pipe[0:3]), to_m(*pipe[3:6])
+        return {"rot": rot, "to_m": to_m, "zone": zone, "truck": truck, "pipe": pipe}
+
+    def _surface(self, obs: np.ndarray, scene: dict):
+        """Ground height in frame M along the boom plane, ``surface(r)`` (r in frame M)."""
+        q1 = float(obs[self.lay["q"]][0])
+        points = np.array(
+            [
+                scene["to_m"](r * math.cos(q1), r * math.sin(q1), h)
+                for r, h in zip(PROFILE_RADII, obs[self.lay["profile"]], strict=True)
+            ]
+        )
+        radii, heights = np.hypot(points[:, 0], points[:, 1]), points[:, 2]
+        order = np.argsort(radii)
+        radii, heights = radii[order], heights[order]
+
+        def surface(r: float) -> float:
+            return float(np.interp(r, radii, heights))
+
+        return surface
+
     def act(self, observation: np.ndarray, memory: dict) -> np.ndarray:
         obs = np.asarray(observation, dtype=np.float64)
         q = obs[self.lay["q"]]
-        zone = obs[self.lay["zone"]]
+        if memory["stage"] is None:
+            memory["scene"] = self._scene(obs)
+        scene = memory["scene"]
+        zone = scene["zone"]
         fill = float(obs[self.lay["fill"]][0])
         azimuth = math.atan2(zone[3], zone[2])
         r_near, r_far = math.hypot(zone[0], zone[1]), math.hypot(zone[2], zone[3])
         if memory["stage"] is None:
             # Approach: bucket 2 m above the far end (the ground there is read later).
-            self._set(memory, "approach", bp.dig_path(azimuth, r_near, r_far, 0.0, _flat)[:1], q)
+            first = bp.dig_path(azimuth, r_near, r_far, 0.0, _flat, self.style)[:1]
+            self._set(memory, "approach", first, q)
         stage = memory["stage"]
         if stage == "approach" and self._done(q, memory):
-            profile = obs[self.lay["profile"]]
-
-            def surface(r: float) -> float:
-                return float(np.interp(r, PROFILE_RADII, profile))
-
+            surface = self._surface(obs, scene)
             ground = max(surface(r) for r in np.linspace(r_near, r_far, 8))
-            depth = bp.allowed_depth(zone, obs[self.lay["pipe"]], self.m, self.safety, ground)
+            depth = bp.allowed_depth(zone, scene["pipe"], self.m, self.safety, ground)
             memory["depth"] = depth
             memory["surface"] = surface
-            self._set(memory, "dig", bp.dig_path(azimuth, r_near, r_far, depth, surface)[1:], q)
+            path = bp.dig_path(azimuth, r_near, r_far, depth, surface, self.style)
+            self._set(memory, "dig", path[1:], q)
         elif stage == "dig" and (fill >= 0.97 * self.m.bucket_capacity or self._done(q, memory)):
-            tip = obs[self.lay["tip"]]
+            tip = scene["rot"].T @ obs[self.lay["tip"]]
             beta = float(obs[self.lay["bucket"]][0])
             here = memory["surface"](math.hypot(tip[0], tip[1]))
-            self._set(memory, "lift", bp.curl_lift_path(tip, beta, here, self.m), q)
+            self._set(memory, "lift", bp.curl_lift_path(tip, beta, here, self.m, self.style), q)
         elif stage == "lift" and self._done(q, memory):
-            waypoints, _ = bp.carry_dump_path(azimuth, obs[self.lay["truck"]], self.m)
+            waypoints, _ = bp.carry_dump_path(azimuth, scene["truck"], self.m)
             self._set(memory, "dump", waypoints, q)
         return self._follow(obs, memory)
 
