@@ -47,6 +47,7 @@ BETA_CARRY = -2.6
 BETA_DUMP = -0.35
 PIPE_MARGIN = 0.25  # m beyond the safety distance
 DRAG_STEP = 0.25  # m
+CURL_STEP = 0.25  # rad
 
 
 @dataclass(frozen=True)
@@ -58,7 +59,8 @@ class Style:
     descent (rad below horizontal) of a ramp from the surface at the far end
     to the cut depth. ``beta_open``: bucket angle while entering.
     ``r_stop``: the drag ends no nearer the swing axis than this (m).
-    ``curl_rise``: the pin rises this much while the bucket curls (m).
+    ``curl_rise``: the pin rises this much per radian of curl (m/rad), in
+    steps of ``CURL_STEP`` (0: one waypoint, the pin fixed).
     ``lift_inwards``: the pin moves this much toward the machine while lifting (m).
     """
 
@@ -83,7 +85,7 @@ V1_STYLE = Style(
     penetration_angle=math.radians(25.0),
     beta_open=-1.35,
     r_stop=4.3,
-    curl_rise=0.5,
+    curl_rise=0.9,
     lift_inwards=0.0,
 )
 
@@ -183,11 +185,17 @@ def curl_lift_path(
         tr = pr + m.L4 * math.cos(b)
         return (c * tr, s * tr, pz + m.L4 * math.sin(b))
 
-    curl_z = pin_z + style.curl_rise
+    turn = abs(BETA_CARRY - beta)
+    n = max(int(math.ceil(turn / CURL_STEP)), 1) if style.curl_rise > 0.0 else 1
+    curl = []
+    for k in range(1, n + 1):
+        b = beta + (BETA_CARRY - beta) * k / n
+        curl.append(Waypoint("curl", tip_at(pin_r, pin_z + style.curl_rise * turn * k / n, b), b))
+    curl_z = pin_z + style.curl_rise * turn
     lift_r = pin_r - style.lift_inwards
     lift_z = max(curl_z + 0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY))
     return [
-        Waypoint("curl", tip_at(pin_r, curl_z, BETA_CARRY), BETA_CARRY),
+        *curl,
         Waypoint("lift", tip_at(lift_r, lift_z, BETA_CARRY), BETA_CARRY),
     ]
 

@@ -26,6 +26,8 @@ from motiongym.envs.excavator.observation import PROFILE_RADII, layout
 from motiongym.envs.excavator.params import params_for
 
 REACHED = 2e-3  # rad: a waypoint counts as reached
+STALL_STEPS = 2  # steps without motion short of the goal: stopped by the ground
+RAISE = 0.3  # m: straight up before curling anew
 
 
 class _ExcavatorPolicy(ScriptedPolicy):
@@ -112,12 +114,27 @@ class DigCyclePolicy(_ExcavatorPolicy):
         self.style = bp.V1_STYLE if self.params.physics == "v1" else bp.V0_STYLE
 
     def new_memory(self) -> dict:
-        return {"stage": None, "goals": None, "index": 0, "depth": None}
+        return {"stage": None, "goals": None, "index": 0, "depth": None, "still": 0, "replans": 0}
+
+    def _stalled(self, obs: np.ndarray, memory: dict) -> bool:
+        """Whether the machine has not moved for ``STALL_STEPS`` steps short of its goal
+        (physics v1: the ground stopped it)."""
+        moving = np.max(np.abs(obs[self.lay["qdot"]])) > 1e-4
+        memory["still"] = (
+            0 if moving or self._done(obs[self.lay["q"]], memory) else memory["still"] + 1
+        )
+        return memory["still"] >= STALL_STEPS
 
     def describe(self, memory: dict) -> dict:
         """``stage`` (None, "approach", "dig", "lift", "dump"), ``cut_depth`` (m, None
-        before the dig is planned) and ``waypoint`` (index of the goal tracked)."""
-        return {"stage": memory["stage"], "cut_depth": memory["depth"], "waypoint": memory["index"]}
+        before the dig is planned), ``waypoint`` (index of the goal tracked) and
+        ``replans`` (curls started anew after the ground stopped the bucket)."""
+        return {
+            "stage": memory["stage"],
+            "cut_depth": memory["depth"],
+            "waypoint": memory["index"],
+            "replans": memory["replans"],
+        }
 
     def _set(self, memory: dict, stage: str, waypoints: list[bp.Waypoint], q: np.ndarray):
         goals, q_prev = [], q
@@ -203,11 +220,19 @@ class DigCyclePolicy(_ExcavatorPolicy):
             memory["surface"] = surface
             path = bp.dig_path(azimuth, r_near, r_far, depth, surface, self.style)
             self._set(memory, "dig", path[1:], q)
-        elif stage == "dig" and (fill >= 0.97 * self.m.bucket_capacity or self._done(q, memory)):
+        elif (
+            stage == "dig" and (fill >= 0.97 * self.m.bucket_capacity or self._done(q, memory))
+        ) or (stage == "lift" and self._stalled(obs, memory)):
+            # Curl and lift; if the ground stops the bucket while it curls (a pile
+            # pushed ahead, a cross slope), first raise it straight up and curl anew.
             tip = scene["rot"].T @ obs[self.lay["tip"]]
             beta = float(obs[self.lay["bucket"]][0])
             here = memory["surface"](math.hypot(tip[0], tip[1]))
-            self._set(memory, "lift", bp.curl_lift_path(tip, beta, here, self.m, self.style), q)
+            path = bp.curl_lift_path(tip, beta, here, self.m, self.style)
+            if stage == "lift":
+                memory["replans"] += 1
+                path = [bp.Waypoint("raise", (tip[0], tip[1], tip[2] + RAISE), beta), *path]
+            self._set(memory, "lift", path, q)
         elif stage == "lift" and self._done(q, memory):
             waypoints, _ = bp.carry_dump_path(azimuth, scene["truck"], self.m)
             self._set(memory, "dump", waypoints, q)

@@ -9,8 +9,9 @@ speed of the slowest one) with the largest ``lambda`` that keeps
 * the last step exact (dead-beat): ``lambda <= 1 / dt``;
 * with acceleration limits ``accel_max`` (rad/s2): every joint able to stop
   at the goal in steps of ``dt`` (``v^2 / (2 a) + v dt / 2 <= |e|``), and
-  each rate within ``accel_max_j dt`` of the current one (the observed
-  ``qdot``);
+  the rates moved from the current ones (the observed ``qdot``) toward
+  those by the largest common fraction that changes none by more than
+  ``accel_max_j dt`` (from rest, the joints start along the line);
 * with a shared pump (``pump_share``: the fraction of the pump's flow a
   function draws at full rate), the demand ``sum_j |v_j| / rate_max_j
   share_j`` at most 1, so that the pump never scales the rates itself.
@@ -73,8 +74,16 @@ def track(
         lam = min(lam, float(np.min(stop / e)))
     rate = lam * error
     if qdot is not None:
-        step = accel * dt
-        rate = np.clip(rate, np.asarray(qdot, float) - step, np.asarray(qdot, float) + step)
+        # Move from the current rates toward the wanted ones by the largest common
+        # fraction the acceleration limits allow: from rest the joints start along
+        # the straight line (a per-joint clip would bend the path).
+        current = np.asarray(qdot, float)
+        change = np.abs(rate - current)
+        fraction = min(
+            1.0,
+            float(np.min(np.where(change > 1e-12, accel * dt / np.maximum(change, 1e-12), np.inf))),
+        )
+        rate = current + fraction * (rate - current)
     return np.clip(rate / rate_max, -1.0, 1.0).astype(np.float32)
 
 
