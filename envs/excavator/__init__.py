@@ -17,4 +17,16 @@ REGISTRATIONS: tuple[dict, ...] = (
         "entry_point": "motiongym.envs.excavator.env:ExcavatorEnv",
         "max_episode_steps": 600,
     },
+    {
+        "id": "motiongym/ExcavatorReach-v1",
+        "entry_point": "motiongym.envs.excavator.env:ExcavatorReachEnv",
+        "max_episode_steps": 200,
+        "kwargs": {"physics": "v1", "slope": 0.1},
+    },
+    {
+        "id": "motiongym/Excavator-v1",
+        "entry_point": "motiongym.envs.excavator.env:ExcavatorEnv",
+        "max_episode_steps": 600,
+        "kwargs": {"physics": "v1", "slope": 0.1},
+    },
 )

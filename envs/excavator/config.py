@@ -74,6 +74,10 @@ class Machine:
     n_gamma: float = 1.5  # weight factor (Reece charts, rake ~45 deg, phi ~30 deg)
     n_c: float = 2.5  # cohesion factor
     min_speed_fraction: float = 0.05  # the tip never locks completely (v0 soil only)
+    # Physics v1 (see hydraulics.py and digging.py).
+    accel_max: tuple[float, float, float, float] = (0.6, 1.5, 1.75, 2.5)  # rad/s2
+    pump_share: tuple[float, float, float, float] = (0.45, 0.95, 0.95, 0.45)
+    swell: float = 1.25  # loose / bank volume (common earth, loam)
 
     def __post_init__(self) -> None:
         """Every field checked (``machine.<name>`` in the message); see :data:`LIMITS`."""
@@ -154,6 +158,9 @@ LIMITS: dict[str, tuple[float, float, int]] = {
     "n_gamma": (0.0, 100.0, 0),
     "n_c": (0.0, 100.0, 0),
     "min_speed_fraction": (0.0, 1.0, 0),
+    "accel_max": (1e-3, 100.0, 4),
+    "pump_share": (0.0, 4.0, 4),
+    "swell": (1.0, 2.0, 0),
 }
 
 DEFAULT_MACHINE = Machine()

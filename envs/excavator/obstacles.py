@@ -52,7 +52,10 @@ class Pipe:
 
 @dataclass(frozen=True)
 class Truck:
-    """A truck body: footprint centre and yaw, half length and width, rim height (m, rad)."""
+    """A truck body: footprint centre and yaw, half length and width, rim height (m, rad).
+
+    The box spans ``floor`` (the ground) to ``height`` (the rim), both heights in frame O.
+    """
 
     cx: float
     cy: float
@@ -60,6 +63,7 @@ class Truck:
     half_length: float
     half_width: float
     height: float
+    floor: float = 0.0  # m: the ground under the body (0 on level ground)
 
     def as_array(self) -> np.ndarray:
         """``[cx, cy, yaw, half_length, half_width, height]``, shape (6,)."""
@@ -90,7 +94,7 @@ class Truck:
     def box(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
         """The box in its own frame (along, across, up): ``(low, high)`` corners (m)."""
         hl, hw = self.half_length, self.half_width
-        return (-hl, -hw, 0.0), (hl, hw, self.height)
+        return (-hl, -hw, self.floor), (hl, hw, self.height)
 
 
 def pipe_clearance(

@@ -24,13 +24,14 @@ machine, z up, the swing axis at the origin, the ground near z = 0.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from motiongym.envs.excavator.config import Machine
-from motiongym.envs.excavator.kinematics import arm_points
+from motiongym.envs.excavator.kinematics import arm_points, base_rotation
 from motiongym.envs.excavator.obstacles import Pipe, Truck, truck_clearance
 
 GRID_ORIGIN = (-11.0, -11.0)  # m
@@ -65,7 +66,7 @@ class DigZone:
         ys = [s * r + c * t for r in (near, far) for t in (-side, side)]
         i0, i1 = _cell_range(min(xs), max(xs), GRID_ORIGIN[0], GRID_SHAPE[0])
         j0, j1 = _cell_range(min(ys), max(ys), GRID_ORIGIN[1], GRID_SHAPE[1])
-        x, y = _XS[i0:i1, None], _YS[None, j0:j1]
+        x, y = CELL_XS[i0:i1, None], CELL_YS[None, j0:j1]
         along = c * x + s * y
         across = -s * x + c * y
         inside = np.zeros(GRID_SHAPE, dtype=bool)
@@ -87,12 +88,56 @@ class Scene:
     truck: Truck
     zone: DigZone | None = None
     target: np.ndarray | None = None  # (4,) tip x, y, z (m) and bucket angle (rad)
+    base: tuple[float, float, float] = (0.0, 0.0, 0.0)  # roll, pitch, yaw (rad): H_M^O
 
 
-_XS = GRID_ORIGIN[0] + (np.arange(GRID_SHAPE[0]) + 0.5) * GRID_CELL  # (nx,) cell centres
-_YS = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL  # (ny,)
+def sample_base(rng: np.random.Generator, slope: float) -> tuple[float, float, float]:
+    """Base roll and pitch uniform in ``[-slope, slope]`` (no draw on level ground)."""
+    if slope == 0.0:
+        return (0.0, 0.0, 0.0)
+    roll, pitch = rng.uniform(-slope, slope, size=2)
+    return (float(roll), float(pitch), 0.0)
+
+
+def ground_plane(base: tuple[float, float, float]) -> tuple[float, float]:
+    """``(gx, gy)`` of the ground plane ``z = gx x + gy y`` under a base turned by ``base``.
+
+    The tracks stand on the plane through the origin whose normal is the
+    base's z axis ``R e_z`` (eq. 2): ``z = -(n_x x + n_y y) / n_z``.
+    """
+    r = base_rotation(*base)
+    return -r[0, 2] / r[2, 2], -r[1, 2] / r[2, 2]
+
+
+def _tilt(scene_parts: tuple, base: tuple[float, float, float]):
+    """Heights, pipe and truck of a level scene laid on the base's ground plane.
+
+    Heights and the pipe's ends rise by the plane's height under them; the
+    truck stands on the plane at its centre (``floor``), its rim as high above it.
+    Parts given as None stay None.
+    """
+    heights, pipe, truck = scene_parts
+    if base == (0.0, 0.0, 0.0):
+        return heights, pipe, truck
+    gx, gy = ground_plane(base)
+    heights = heights + gx * CELL_XS[:, None] + gy * CELL_YS[None, :]
+    if pipe is not None:
+        a, b = pipe.a, pipe.b
+        pipe = Pipe(
+            a=(a[0], a[1], a[2] + gx * a[0] + gy * a[1]),
+            b=(b[0], b[1], b[2] + gx * b[0] + gy * b[1]),
+            radius=pipe.radius,
+        )
+    if truck is not None:
+        floor = gx * truck.cx + gy * truck.cy
+        truck = dataclasses.replace(truck, floor=floor, height=truck.height + floor)
+    return heights, pipe, truck
+
+
+CELL_XS = GRID_ORIGIN[0] + (np.arange(GRID_SHAPE[0]) + 0.5) * GRID_CELL  # (nx,) cell centres
+CELL_YS = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL  # (ny,)
 # Undulations fade in from the pad's edge over 1 m.
-_FADE = np.clip((np.hypot(_XS[:, None], _YS[None, :]) - PAD_RADIUS) / 1.0, 0.0, 1.0)
+_FADE = np.clip((np.hypot(CELL_XS[:, None], CELL_YS[None, :]) - PAD_RADIUS) / 1.0, 0.0, 1.0)
 
 
 def _cell_range(lo: float, hi: float, origin: float, n: int) -> tuple[int, int]:
@@ -115,8 +160,8 @@ def sample_heights(rng: np.random.Generator) -> np.ndarray:
         direction = rng.uniform(0.0, 2 * math.pi)
         phase = rng.uniform(0.0, 2 * math.pi)
         amp = rng.uniform(0.0, 0.075)
-        a = k * math.cos(direction) * _XS + phase  # (nx,)
-        b = k * math.sin(direction) * _YS  # (ny,)
+        a = k * math.cos(direction) * CELL_XS + phase  # (nx,)
+        b = k * math.sin(direction) * CELL_YS  # (ny,)
         columns += [amp * np.sin(a), amp * np.cos(a)]
         rows += [np.cos(b), np.sin(b)]
     return (np.column_stack(columns) @ np.vstack(rows)) * _FADE
@@ -148,7 +193,8 @@ def sample_pipe(rng: np.random.Generator, azimuth: float, r_lo: float, r_hi: flo
 
 
 def sample_dig_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0) -> Scene:
-    """Ground, dig zone, pipe and truck for one dig cycle."""
+    """Ground, dig zone, pipe and truck for one dig cycle (on a slope: see :func:`_tilt`)."""
+    base = sample_base(rng, slope)
     heights = sample_heights(rng)
     azimuth = math.radians(rng.uniform(-35.0, 35.0))
     r_far = rng.uniform(7.0, 8.5)
@@ -156,13 +202,23 @@ def sample_dig_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0) -
     zone = DigZone(azimuth, r_far - length, r_far, rng.uniform(0.5, 1.0))
     pipe = sample_pipe(rng, azimuth, zone.r_near - 1.0, zone.r_far + 2.0)
     truck = sample_truck(rng)
-    return Scene(heights, pipe, truck, zone=zone)
+    heights, pipe, truck = _tilt((heights, pipe, truck), base)
+    return Scene(heights, pipe, truck, zone=zone, base=base)
 
 
 def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0) -> Scene:
-    """Ground, reachable target pose, pipe and truck for a reach."""
+    """Ground, reachable target pose, pipe and truck for a reach (on a slope: :func:`_tilt`).
+
+    On a slope the target's tip is in frame O and its angle is the bucket
+    angle in the machine's frame M (``q2 + q3 + q4``).
+    """
+    base = sample_base(rng, slope)
     heights = sample_heights(rng)
     truck = sample_truck(rng)
+    level = base == (0.0, 0.0, 0.0)
+    if not level:
+        heights, _, truck = _tilt((heights, None, truck), base)
+        rotation = base_rotation(*base)
     lo = np.array(m.q_min) + 0.05
     hi = np.array(m.q_max) - 0.05
     lo[0], hi[0] = -math.pi / 3, math.pi / 3
@@ -171,6 +227,8 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
     for _ in range(10_000):
         q = rng.uniform(lo, hi)
         pts = arm_points(*q, m)
+        if not level:
+            pts = tuple(tuple(rotation @ p) for p in pts)
         tip = pts[-1]
         ground = heights[ix(tip[0]), iy(tip[1])]
         if math.hypot(tip[0], tip[1]) < 4.0 or not 0.0 <= tip[2] - ground <= 2.5:
@@ -185,7 +243,14 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
     azimuth = math.atan2(tip[1], tip[0])
     r_tip = math.hypot(tip[0], tip[1])
     pipe = sample_pipe(rng, azimuth, r_tip - 3.0, r_tip + 3.0)
-    depth = min(pipe.a[2], tip[2] - 1.0 - pipe.radius)
-    pipe = Pipe(a=(*pipe.a[:2], depth), b=(*pipe.b[:2], depth), radius=pipe.radius)
+    if level:
+        depth = min(pipe.a[2], tip[2] - 1.0 - pipe.radius)
+        pipe = Pipe(a=(*pipe.a[:2], depth), b=(*pipe.b[:2], depth), radius=pipe.radius)
+    else:  # laid on the plane, then lowered until all of it is 1 m below the tip
+        _, pipe, _ = _tilt((heights, pipe, truck), base)
+        drop = max(pipe.a[2], pipe.b[2]) - (tip[2] - 1.0 - pipe.radius)
+        if drop > 0.0:
+            a, b = pipe.a, pipe.b
+            pipe = Pipe((a[0], a[1], a[2] - drop), (b[0], b[1], b[2] - drop), pipe.radius)
     target = np.array([tip[0], tip[1], tip[2], q[1] + q[2] + q[3]])
-    return Scene(heights, pipe, truck, target=target)
+    return Scene(heights, pipe, truck, target=target, base=base)

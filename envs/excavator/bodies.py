@@ -1,0 +1,217 @@
+"""Collision bodies that contain the machine's parts (physics v1).
+
+Every part is a convex body that contains it (a capsule about a link's
+pin-to-pin line, or an oriented box); contact with the pipe, the truck or the
+machine itself is a distance between bodies <= 0. Dimensions (m) of the 20 t
+class (Cat 320 / Komatsu PC210 / Volvo EC220 spec-sheet overall sizes),
+rounded up so the body contains the part:
+
+===========  ================================================================
+part         body
+===========  ================================================================
+boom         capsule, radius 0.40 about foot pin - stick pin (contains a
+             0.60 m deep x 0.45 m wide box girder: half diagonal 0.375)
+stick        capsule, radius 0.30 about stick pin - bucket pin (contains a
+             0.45 x 0.30 section: half diagonal 0.27)
+bucket       box in the bucket frame: along the pin-to-tip axis ``u`` from
+             -0.15 to ``L4`` + 0.05, behind the opening (``-n``, the shell's
+             bulge) from -0.05 to 0.90, across ``+-(bucket_width / 2 + 0.05)``
+             (the cutting edge's full width and the side plates)
+house        box turning with the swing: ``x'`` (ahead along the swing
+             azimuth) -2.8 to 1.0 (tail swing radius 2.8 m), ``y'`` +-1.4,
+             z 0.95 to 2.95 above the ground (cab roof)
+tracks       box fixed to the base: x +-2.25 (4.5 m track length), y +-1.5
+             (3.0 m over 600 mm shoes), z 0 to 0.92
+===========  ================================================================
+
+:func:`machine_bodies` places them from the arm points (frame O, any base
+pose); the pairs checked for self-collision are :data:`SELF_PAIRS` (a link is
+not checked against the part it hangs from). Distances are exact:
+capsule-capsule by :func:`motiongym.envs.geometry.segment_distance`,
+capsule-box by :func:`.obstacles.segment_box_distance` in the box's frame,
+box-box as the smallest distance from each box's 12 edges to the other box
+(exact for disjoint convex boxes: a closest pair always has a point on an
+edge of one of them), 0 when one box's centre lies in the other.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from motiongym.envs.excavator.obstacles import segment_box_distance
+from motiongym.envs.geometry import segment_distance
+
+BOOM_RADIUS = 0.40
+STICK_RADIUS = 0.30
+BUCKET_BACK = 0.90  # m: the shell's bulge behind the opening
+BUCKET_SIDE = 0.05  # m: side plates beyond the cutting edge
+HOUSE = ((-2.8, 1.0), (-1.4, 1.4), (0.95, 2.95))  # x', y', z (m)
+TRACKS = ((-2.25, 2.25), (-1.5, 1.5), (0.0, 0.92))  # x, y, z (m, frame M)
+# The boom is not checked against the tracks: the straight pin-to-pin line of
+# a bent boom passes where the real boom does not (within the joint limits,
+# the boom's underside meets the ground first, which stops it).
+SELF_PAIRS = (("bucket", "tracks"), ("bucket", "house"), ("stick", "tracks"), ("stick", "house"))
+
+Vec = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Capsule:
+    a: Vec
+    b: Vec
+    radius: float
+
+    def sphere(self) -> tuple[Vec, float]:
+        """A bounding sphere ``(centre, radius)``."""
+        c = tuple(0.5 * (p + q) for p, q in zip(self.a, self.b, strict=True))
+        return c, 0.5 * math.dist(self.a, self.b) + self.radius
+
+
+@dataclass(frozen=True)
+class Box:
+    """An oriented box: centre, unit axes (rows), half extents (m)."""
+
+    centre: Vec
+    axes: tuple[Vec, Vec, Vec]
+    half: Vec
+
+    def local(self, p) -> Vec:
+        c, (a, b, e) = self.centre, self.axes
+        x, y, z = p[0] - c[0], p[1] - c[1], p[2] - c[2]
+        return (
+            a[0] * x + a[1] * y + a[2] * z,
+            b[0] * x + b[1] * y + b[2] * z,
+            e[0] * x + e[1] * y + e[2] * z,
+        )
+
+    def gap(self, p) -> float:
+        """Distance from the point ``p`` to the box (0 inside)."""
+        total = 0.0
+        for x, h in zip(self.local(p), self.half, strict=True):
+            g = abs(x) - h
+            if g > 0.0:
+                total += g * g
+        return math.sqrt(total)
+
+    def world(self, u: float, v: float, w: float) -> Vec:
+        a0, a1, a2 = self.axes
+        c = self.centre
+        return tuple(c[i] + u * a0[i] + v * a1[i] + w * a2[i] for i in range(3))
+
+    def corners(self) -> list[Vec]:
+        hx, hy, hz = self.half
+        return [
+            self.world(sx * hx, sy * hy, sz * hz)
+            for sx in (-1, 1)
+            for sy in (-1, 1)
+            for sz in (-1, 1)
+        ]
+
+    def edges(self) -> list[tuple[Vec, Vec]]:
+        c = self.corners()  # index bits: x 4, y 2, z 1
+        return [(c[i], c[i | bit]) for bit in (4, 2, 1) for i in range(8) if not i & bit]
+
+    def sphere(self) -> tuple[Vec, float]:
+        return self.centre, math.sqrt(sum(h * h for h in self.half))
+
+    def contains(self, p) -> bool:
+        return all(abs(x) <= h for x, h in zip(self.local(p), self.half, strict=True))
+
+
+def box_from_ranges(origin: Vec, axes, ranges) -> Box:
+    """The box spanning ``ranges`` ((lo, hi) per axis) along ``axes`` from ``origin``."""
+    mid = [0.5 * (lo + hi) for lo, hi in ranges]
+    centre = tuple(origin[i] + sum(mid[k] * axes[k][i] for k in range(3)) for i in range(3))
+    return Box(centre, tuple(tuple(a) for a in axes), tuple(0.5 * (hi - lo) for lo, hi in ranges))
+
+
+def segment_to_box(a, b, box: Box) -> float:
+    """Distance from the segment ``a b`` to ``box`` (0 when they meet)."""
+    low = tuple(-h for h in box.half)
+    return segment_box_distance(box.local(a), box.local(b), low, box.half)
+
+
+def box_to_box(p: Box, q: Box) -> float:
+    """Distance between two boxes (0 when they overlap)."""
+    if p.contains(q.centre) or q.contains(p.centre):
+        return 0.0
+    best = math.inf
+    for one, other in ((p, q), (q, p)):
+        for a, b in one.edges():
+            d = segment_to_box(a, b, other)
+            if d < best:
+                best = d
+                if d == 0.0:
+                    return 0.0
+    return best
+
+
+def distance(p, q) -> float:
+    """Surface distance between two bodies (capsules or boxes), negative for a capsule inside."""
+    if isinstance(p, Capsule) and isinstance(q, Capsule):
+        return segment_distance(p.a, p.b, q.a, q.b) - p.radius - q.radius
+    if isinstance(p, Capsule):
+        return segment_to_box(p.a, p.b, q) - p.radius
+    if isinstance(q, Capsule):
+        return segment_to_box(q.a, q.b, p) - q.radius
+    return box_to_box(p, q)
+
+
+def sphere_gap(p, q) -> float:
+    """A lower bound of :func:`distance` from the bodies' bounding spheres."""
+    (c1, r1), (c2, r2) = p.sphere(), q.sphere()
+    return math.dist(c1, c2) - r1 - r2
+
+
+def bucket_box(pin: Vec, tip: Vec, lateral: Vec, width: float) -> Box:
+    """The bucket's body: ``u`` = pin to tip, ``-n`` = ``lateral x u`` (behind the opening)."""
+    length = math.dist(pin, tip)
+    u = tuple((t - p) / length for p, t in zip(pin, tip, strict=True))
+    back = _cross(lateral, u)
+    ranges = (
+        (-0.15, length + 0.05),
+        (-0.05, BUCKET_BACK),
+        (-(0.5 * width + BUCKET_SIDE), 0.5 * width + BUCKET_SIDE),
+    )
+    return box_from_ranges(pin, (u, back, lateral), ranges)
+
+
+def _cross(a, b) -> Vec:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def machine_bodies(
+    points, swing: float, rotation, bucket_width: float, L0: float, names=None
+) -> dict:
+    """``{part: body}`` in frame O from the arm points (frame O) and the base rotation.
+
+    ``points`` are foot, stick pin, bucket pin and tip; ``rotation`` is the
+    base's ``R`` (rows, 3 x 3, frame M to O; None on level ground). The
+    house and the tracks are centred on the swing axis, at ``x = -L0`` in M.
+    ``names`` (default: all five) selects the parts built.
+    """
+    foot, stick_pin, pin, tip = points
+    c1, s1 = math.cos(swing), math.sin(swing)
+    rot = _apply(rotation)
+    up, axis = rot((0.0, 0.0, 1.0)), rot((-L0, 0.0, 0.0))  # where the swing axis meets the ground
+    build = {
+        "boom": lambda: Capsule(foot, stick_pin, BOOM_RADIUS),
+        "stick": lambda: Capsule(stick_pin, pin, STICK_RADIUS),
+        # The bucket's lateral axis is the joint axis z = (s1, -c1, 0).
+        "bucket": lambda: bucket_box(pin, tip, rot((s1, -c1, 0.0)), bucket_width),
+        "house": lambda: box_from_ranges(
+            axis, (rot((c1, s1, 0.0)), rot((-s1, c1, 0.0)), up), HOUSE
+        ),
+        "tracks": lambda: box_from_ranges(
+            axis, (rot((1.0, 0.0, 0.0)), rot((0.0, 1.0, 0.0)), up), TRACKS
+        ),
+    }
+    return {name: build[name]() for name in (names or build)}
+
+
+def _apply(rotation):
+    if rotation is None:
+        return lambda v: v
+    r = rotation
+    return lambda v: tuple(r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2] for i in range(3))
