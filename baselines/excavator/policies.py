@@ -21,7 +21,7 @@ from gymnasium import spaces
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.excavator.kinematics import base_rotation
+from motiongym.envs.excavator.kinematics import base_pose, base_rotation
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
 from motiongym.envs.excavator.params import params_for
 
@@ -46,8 +46,10 @@ class _ExcavatorPolicy(ScriptedPolicy):
         self.safety = self.params.pipe_safety
         self.lay = layout(self.TASK, self.params.physics)
 
-    def _goal(self, wp: bp.Waypoint, q_start: np.ndarray) -> np.ndarray:
-        result = solve_pose(np.array(wp.tip), wp.beta, self.m, q_start)
+    def _goal(
+        self, wp: bp.Waypoint, q_start: np.ndarray, base: np.ndarray | None = None
+    ) -> np.ndarray:
+        result = solve_pose(np.array(wp.tip), wp.beta, self.m, q_start, base=base)
         # A pose beyond the limits is tracked as far as the joints go.
         return np.clip(result.q, self.m.q_min, self.m.q_max)
 
@@ -86,11 +88,15 @@ class ReachPolicy(_ExcavatorPolicy):
         obs = np.asarray(observation, dtype=np.float64)
         q = obs[self.lay["q"]]
         if memory["goals"] is None:
+            # The target tip is in frame O; on a slope (v1) the IK takes the base pose.
+            base = None
+            if "base" in self.lay:
+                base = base_pose(rpy=(*(float(v) for v in obs[self.lay["base"]]), 0.0))
             target = obs[self.lay["target"]]
             tip, beta = target[:3], float(target[3])
             above = bp.Waypoint("above", (tip[0], tip[1], tip[2] + 1.0), beta)
-            q_above = self._goal(above, q)
-            q_target = self._goal(bp.Waypoint("target", tuple(tip), beta), q_above)
+            q_above = self._goal(above, q, base)
+            q_target = self._goal(bp.Waypoint("target", tuple(tip), beta), q_above, base)
             memory["goals"] = [q_above, q_target]
             memory["tolerance"] = 0.05
         return self._follow(obs, memory)
