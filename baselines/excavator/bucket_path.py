@@ -165,39 +165,48 @@ def dig_path(
 
 
 def curl_lift_path(
-    tip: np.ndarray, beta: float, surface_here: float, m: Machine, style: Style = V0_STYLE
+    tip: np.ndarray,
+    beta: float,
+    surface_here: float,
+    m: Machine,
+    style: Style = V0_STYLE,
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0),
 ) -> list[Waypoint]:
     """Curl about the bucket pin, then lift the pin (``style``: inwards) and up.
 
     The pin (``tip - L4 [cos beta, sin beta]`` in the boom plane) rises
-    ``style.curl_rise`` while the bucket turns to ``beta_carry`` (the policy
-    clips joint goals to the joint ranges); then it moves
+    ``style.curl_rise`` per radian while the bucket turns to ``beta_carry``
+    (the policy clips joint goals to the joint ranges); then it moves
     ``style.lift_inwards`` toward the machine and up until the tip is 0.8 m
-    above the surface.
+    above the surface. "Up" is ``up`` (unit, frame M): on a slope the world's
+    vertical, along which the trench's walls stand (rising along the tilted
+    frame's z would carry the bucket sideways into them).
     """
     x, y, z = (float(v) for v in tip)
     r = math.hypot(x, y)
     c, s = (x / r, y / r) if r > 1e-9 else (1.0, 0.0)
-    pin_r = r - m.L4 * math.cos(beta)
-    pin_z = z - m.L4 * math.sin(beta)
+    pin = np.array([x, y, z]) - m.L4 * np.array(
+        [c * math.cos(beta), s * math.cos(beta), math.sin(beta)]
+    )
+    up_v = np.asarray(up, float)
 
-    def tip_at(pr: float, pz: float, b: float) -> tuple[float, float, float]:
-        tr = pr + m.L4 * math.cos(b)
-        return (c * tr, s * tr, pz + m.L4 * math.sin(b))
+    def tip_at(p: np.ndarray, b: float) -> tuple[float, float, float]:
+        return (
+            float(p[0] + c * m.L4 * math.cos(b)),
+            float(p[1] + s * m.L4 * math.cos(b)),
+            float(p[2] + m.L4 * math.sin(b)),
+        )
 
     turn = abs(BETA_CARRY - beta)
     n = max(int(math.ceil(turn / CURL_STEP)), 1) if style.curl_rise > 0.0 else 1
     curl = []
     for k in range(1, n + 1):
         b = beta + (BETA_CARRY - beta) * k / n
-        curl.append(Waypoint("curl", tip_at(pin_r, pin_z + style.curl_rise * turn * k / n, b), b))
-    curl_z = pin_z + style.curl_rise * turn
-    lift_r = pin_r - style.lift_inwards
-    lift_z = max(curl_z + 0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY))
-    return [
-        *curl,
-        Waypoint("lift", tip_at(lift_r, lift_z, BETA_CARRY), BETA_CARRY),
-    ]
+        curl.append(Waypoint("curl", tip_at(pin + style.curl_rise * turn * k / n * up_v, b), b))
+    curled = pin + style.curl_rise * turn * up_v
+    rise = max(0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY) - curled[2]) / up_v[2]
+    lift = curled + rise * up_v - style.lift_inwards * np.array([c, s, 0.0])
+    return [*curl, Waypoint("lift", tip_at(lift, BETA_CARRY), BETA_CARRY)]
 
 
 def carry_dump_path(

@@ -27,7 +27,7 @@ from motiongym.envs.excavator.params import params_for
 
 REACHED = 2e-3  # rad: a waypoint counts as reached
 STALL_STEPS = 2  # steps without motion short of the goal: stopped by the ground
-RAISE = 0.3  # m: straight up before curling anew
+BOOM_RAISE = 0.1  # rad: the boom alone raised before curling anew
 
 
 class _ExcavatorPolicy(ScriptedPolicy):
@@ -132,7 +132,7 @@ class DigCyclePolicy(_ExcavatorPolicy):
         return memory["still"] >= STALL_STEPS
 
     def describe(self, memory: dict) -> dict:
-        """``stage`` (None, "approach", "dig", "lift", "dump"), ``cut_depth`` (m, None
+        """``stage`` (None, "approach", "dig", "lift", "raise", "dump"), ``cut_depth`` (m, None
         before the dig is planned), ``waypoint`` (index of the goal tracked) and
         ``replans`` (curls started anew after the ground stopped the bucket)."""
         return {
@@ -226,18 +226,20 @@ class DigCyclePolicy(_ExcavatorPolicy):
             memory["surface"] = surface
             path = bp.dig_path(azimuth, r_near, r_far, depth, surface, self.style)
             self._set(memory, "dig", path[1:], q)
+        elif stage in ("lift", "raise") and self._stalled(obs, memory):
+            # The ground stopped the curling bucket (soil beside the cut, a pile
+            # pushed ahead): raise the boom alone (every part moves up), then curl anew.
+            memory["replans"] += 1
+            goal = np.clip(q + [0.0, BOOM_RAISE, 0.0, 0.0], self.m.q_min, self.m.q_max)
+            memory.update(stage="raise", goals=[goal], index=0, still=0)
         elif (
             stage == "dig" and (fill >= 0.97 * self.m.bucket_capacity or self._done(q, memory))
-        ) or (stage == "lift" and self._stalled(obs, memory)):
-            # Curl and lift; if the ground stops the bucket while it curls (a pile
-            # pushed ahead, a cross slope), first raise it straight up and curl anew.
+        ) or (stage == "raise" and self._done(q, memory)):
             tip = scene["rot"].T @ obs[self.lay["tip"]]
             beta = float(obs[self.lay["bucket"]][0])
             here = memory["surface"](math.hypot(tip[0], tip[1]))
-            path = bp.curl_lift_path(tip, beta, here, self.m, self.style)
-            if stage == "lift":
-                memory["replans"] += 1
-                path = [bp.Waypoint("raise", (tip[0], tip[1], tip[2] + RAISE), beta), *path]
+            up = tuple(scene["rot"][2])  # the world's vertical in frame M
+            path = bp.curl_lift_path(tip, beta, here, self.m, self.style, up)
             self._set(memory, "lift", path, q)
         elif stage == "lift" and self._done(q, memory):
             waypoints, _ = bp.carry_dump_path(azimuth, scene["truck"], self.m)
