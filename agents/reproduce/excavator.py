@@ -45,7 +45,8 @@ from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
 from motiongym.envs.excavator.kinematics import link_frames
 from motiongym.envs.excavator.observation import layout
 
-DIG_ID = "motiongym/Excavator-v0"
+DIG_IDS = ("motiongym/Excavator-v0", "motiongym/Excavator-v1")
+DELIVERED = 0.8  # m3 (loose in v1): the issue's target for one cycle
 V_NAMES = ("E(1,1)", "E(3,1)", "E(1,4)", "E(2,4)", "E(3,4)")
 
 
@@ -79,12 +80,15 @@ def paper_case() -> dict[str, Any]:
     }
 
 
-def dig_cycles(n: int, env_id: str = DIG_ID) -> dict[str, Any]:
-    """The dig-cycle policy on ``n`` seeded scenes of ``env_id`` (seeds 0 .. n-1).
+def dig_cycles(n: int, env_id: str, first_seed: int = 0) -> dict[str, Any]:
+    """The dig-cycle policy on ``n`` seeded scenes of ``env_id`` (seeds from ``first_seed``).
 
     Episodes run through :func:`~motiongym.agents.evaluate.run_episode`; a
-    hook times the policy and reads its public ``diagnostics()`` (the cut depth
-    it chose) and the zone's marked depth from the observation.
+    hook times the policy, reads its public ``diagnostics()`` (the cut depth
+    it chose) and the zone's marked depth from the observation, and counts
+    the steps with a contact of each kind (ground, self: v1 only). A clean
+    delivery (the issue's target): at least :data:`DELIVERED` m3 in the
+    truck with no contact at all (pipe, truck, ground but the cut, self).
     """
     import gymnasium as gym
 
@@ -99,16 +103,19 @@ def dig_cycles(n: int, env_id: str = DIG_ID) -> dict[str, Any]:
     )
     zone = layout("dig")["zone"]
     rows = []
-    for seed in range(n):
-        seen: dict[str, Any] = {}
+    kinds = ("pipe_contact", "truck_contact", "ground_contact", "self_contact")
+    for seed in range(first_seed, first_seed + n):
+        seen: dict[str, Any] = dict.fromkeys(kinds, 0.0)
 
         def hook(step, seen=seen) -> None:
             seen["cut_depth"] = policy.diagnostics().get("cut_depth")
             seen["marked_depth"] = float(step.observation[zone][4])
-            seen["delivered"] = float(step.info["truck_soil"])
+            for kind in kinds:
+                seen[kind] += float(step.info.get(kind, 0.0))
 
         episode = run_episode(env, policy, seed, hook=hook)
-        rows.append({**episode, **seen, "success": bool(episode["is_success"])})
+        clean = episode["truck_soil"] >= DELIVERED and all(seen[k] == 0.0 for k in kinds)
+        rows.append({**episode, **seen, "success": bool(episode["is_success"]), "clean": clean})
     env.close()
 
     def stat(key: str) -> dict[str, float]:
@@ -119,12 +126,14 @@ def dig_cycles(n: int, env_id: str = DIG_ID) -> dict[str, Any]:
     return {
         "env_id": env_id,
         "n": n,
+        "seeds": f"{first_seed}-{first_seed + n - 1}",
         "success_rate": float(np.mean([r["success"] for r in rows])),
+        "clean_delivery_rate": float(np.mean([r["clean"] for r in rows])),
+        "episodes_with_contact": {k: int(sum(r[k] > 0 for r in rows)) for k in kinds},
         "dig_fill_m3": stat("dig_fill"),
         "truck_soil_m3": stat("truck_soil"),
         "spill_m3": stat("spill"),
         "outside_zone_m3": stat("outside_zone"),
-        "pipe_contacts": int(sum(r["pipe_contact"] > 0 for r in rows)),
         "cost_steps_total": float(sum(r["cost"] for r in rows)),
         "min_pipe_clearance_m": float(min(r["pipe_clearance"] for r in rows)),
         "cycle_time_s": stat("elapsed"),
@@ -294,26 +303,29 @@ def _print(results: dict[str, Any]) -> None:
         f"{u['reported_converged']} / {u['n']}  {u['reasons']}",
         "-",
     )
-    d = results["dig_cycle"]
-    table.add_row(
-        "dig cycle success / pipe contacts",
-        f"{100 * d['success_rate']:.0f} % / {d['pipe_contacts']}",
-        "(next step announced)",
-    )
-    table.add_row(
-        "dig fill / delivered / spill / outside zone (mean m3)",
-        f"{d['dig_fill_m3']['mean']:.2f} / {d['truck_soil_m3']['mean']:.2f} / "
-        f"{d['spill_m3']['mean']:.3f} / {d['outside_zone_m3']['mean']:.3f}",
-        "-",
-    )
-    table.add_row(
-        "cycle time (mean, max s); depth limited by pipe",
-        f"{d['cycle_time_s']['mean']:.1f}, {d['cycle_time_s']['max']:.1f}; "
-        f"{d['depth_limited_by_pipe']} / {d['n']}",
-        "-",
-    )
-    for row in excavator_probes.table_rows(results["probes"]):
-        table.add_row(*row)
+    for d in results["dig_cycle"].values():
+        table.add_row(
+            f"dig cycle {d['env_id']}: success / >= {DELIVERED} m3 with 0 contacts "
+            f"(seeds {d['seeds']})",
+            f"{100 * d['success_rate']:.1f} % / {100 * d['clean_delivery_rate']:.1f} %; "
+            f"episodes with contact {d['episodes_with_contact']}",
+            "(next step announced)",
+        )
+        table.add_row(
+            f"dig fill / delivered / spill / outside zone (mean m3), {d['env_id']}",
+            f"{d['dig_fill_m3']['mean']:.2f} / {d['truck_soil_m3']['mean']:.2f} / "
+            f"{d['spill_m3']['mean']:.3f} / {d['outside_zone_m3']['mean']:.3f}",
+            "-",
+        )
+        table.add_row(
+            f"cycle time (mean, max s); depth limited by pipe, {d['env_id']}",
+            f"{d['cycle_time_s']['mean']:.1f}, {d['cycle_time_s']['max']:.1f}; "
+            f"{d['depth_limited_by_pipe']} / {d['n']}",
+            "-",
+        )
+    for probes in results["probes"].values():
+        for row in excavator_probes.table_rows(probes):
+            table.add_row(*row)
     s = results["speed"]
     table.add_row("IK solves/s (paper case)", f"{s['ik_solves_per_s_paper_case']:.0f}", "-")
     table.add_row(
@@ -343,8 +355,10 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
         "unreachable": ik.unreachable(40 if quick else 200),
         "issue_case": ik.issue_case(),
         "cartesian_ik": ik.cartesian_ik(300 if quick else 3000),
-        "dig_cycle": dig_cycles(8 if quick else 100),
-        "probes": excavator_probes.run_probes(DIG_ID),
+        "dig_cycle": {
+            env_id: dig_cycles(8 if quick else 200, env_id, first_seed=1000) for env_id in DIG_IDS
+        },
+        "probes": {env_id: excavator_probes.run_probes(env_id) for env_id in DIG_IDS},
         "speed": speed(2000 if quick else 20000),
     }
     results["figures"] = _figures(out_dir, results["paper_case"])
