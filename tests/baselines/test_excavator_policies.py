@@ -9,28 +9,37 @@ from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.evaluation import evaluate_policy
 
 import motiongym  # noqa: F401
+from motiongym.agents.environments import resolved_env_kwargs
+from motiongym.agents.evaluate import run_episode
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.registry import make_policy
 from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
 from motiongym.envs.excavator.kinematics import bucket_angle, forward
 
+CONTACTS = ("pipe_contact", "truck_contact", "ground_contact", "self_contact")
 
-def _episodes(env_id: str, name: str, seeds) -> list[dict]:
+
+def _episodes(env_id: str, name: str, seeds, style=None) -> list[dict]:
+    """Episodes through the one episode loop; the last info, cost and contacts summed."""
     env = gym.make(env_id)
-    policy = make_policy(env_id, name, env.observation_space, env.action_space, {})
+    kwargs = resolved_env_kwargs(env_id, None)
+    policy = make_policy(env_id, name, env.observation_space, env.action_space, kwargs)
+    if style is not None:
+        policy.style = style
     out = []
     for seed in seeds:
-        obs, info = env.reset(seed=seed)
-        start, done, cost, min_pipe = True, False, 0.0, np.inf
-        while not done:
-            action, _ = policy.predict(obs, episode_start=start)
-            start = False
-            obs, _, terminated, truncated, info = env.step(action)
-            cost += info["cost"]
-            min_pipe = min(min_pipe, info["pipe_clearance"])
-            done = terminated or truncated
-        out.append({**info, "cost_sum": cost, "min_pipe": min_pipe})
+        seen = {"cost_sum": 0.0, "min_pipe": np.inf, **dict.fromkeys(CONTACTS, 0.0)}
+
+        def hook(step, seen=seen) -> None:
+            seen["info"] = step.info
+            seen["cost_sum"] += step.info["cost"]
+            seen["min_pipe"] = min(seen["min_pipe"], step.info["pipe_clearance"])
+            for kind in CONTACTS:
+                seen[kind] += step.info.get(kind, 0.0)
+
+        run_episode(env, policy, seed, hook=hook)
+        out.append({**seen.pop("info"), **seen})
     return out
 
 
@@ -216,3 +225,26 @@ def test_tracking_keeps_the_shared_pump_within_its_flow():
     assert step / np.linalg.norm(step) == pytest.approx(goal / np.linalg.norm(goal))
     # Ablation: without it all four at once ask for 2.8 times the pump's flow.
     assert np.sum(np.abs(track(np.zeros(4), goal, M, 0.1)) * share) > 1.5
+
+
+def _clean(r: dict) -> bool:
+    return r["truck_soil"] >= 0.8 and all(r[kind] == 0.0 for kind in CONTACTS)
+
+
+def test_dig_cycle_on_v1_delivers_without_any_contact():
+    # Slope, hydraulics, a ground that stops every part but a cutting edge.
+    results = _episodes("motiongym/Excavator-v1", "dig-cycle", range(2000, 2010))
+    assert all(r["is_success"] and _clean(r) for r in results)
+
+
+def test_ablation_the_v0_path_on_v1_is_stopped_by_the_ground():
+    # The v0 plunge (steep entry, pin fixed while curling) on the v1 world.
+    results = _episodes("motiongym/Excavator-v1", "dig-cycle", range(2000, 2010), bp.V0_STYLE)
+    assert sum(_clean(r) for r in results) <= 5
+    assert sum(r["ground_contact"] > 0 for r in results) >= 5
+
+
+def test_reach_policy_on_v1():
+    results = _episodes("motiongym/ExcavatorReach-v1", "newton-raphson-reach", range(20))
+    clean = [r["is_success"] and all(r[k] == 0.0 for k in CONTACTS) for r in results]
+    assert sum(clean) >= 17
