@@ -240,8 +240,8 @@ def test_dig_cycle_on_v1_delivers_without_any_contact():
 def test_ablation_the_v0_path_on_v1_is_stopped_by_the_ground():
     # The v0 plunge (steep entry, pin fixed while curling) on the v1 world.
     results = _episodes("motiongym/Excavator-v1", "dig-cycle", range(2000, 2010), bp.V0_STYLE)
-    assert sum(_clean(r) for r in results) <= 5
-    assert sum(r["ground_contact"] > 0 for r in results) >= 5
+    assert sum(_clean(r) for r in results) <= 2  # measured: 0 of 10 (v1 style: 10 of 10)
+    assert sum(r["ground_contact"] > 0 for r in results) >= 3  # measured: 5 of 10
 
 
 def test_reach_policy_on_v1():
