@@ -214,7 +214,7 @@ class ExcavatorReachEnv(ExcavatorBase):
     Version history: v0 (initial); v1 (physics "v1": collision bodies that
     contain the machine, ground and self-collision, hydraulics with rate,
     acceleration and pump-flow limits, the base on a slope up to
-    ``slope`` = 0.15 rad).
+    ``slope`` = 0.1 rad).
     """
     )
 
@@ -281,7 +281,7 @@ class ExcavatorEnv(ExcavatorBase):
     pushing soil, a swell factor (fill and truck soil in loose m3), collision
     bodies that contain the machine, self-collision, hydraulics with rate,
     acceleration and pump-flow limits, the base on a slope up to ``slope`` =
-    0.15 rad).
+    0.1 rad).
     """
     )
 

@@ -124,6 +124,7 @@ class SceneRenderer:
         self.camera.distance, self.camera.elevation, self.camera.azimuth = 24.0, -28.0, -130.0
         self._terrain_key = None
         self._hfield = self.model.hfield("ground").id
+        self._swing_pos = self.model.body("swing").pos.copy()
 
     def _geom(self, name: str) -> int:
         return self.model.geom(name).id
@@ -172,9 +173,17 @@ class SceneRenderer:
         target = getattr(world.scene, "target", None)
         if target is not None:
             model.site_pos[model.site("target").id] = target[:3]
+        self._place_base(getattr(world, "rotation", None))
         mujoco.mj_kinematics(model, data)
         self.renderer.update_scene(data, self.camera)
         return self.renderer.render().copy()
+
+    def _place_base(self, rotation) -> None:
+        """Turn the machine (its first body) by the base rotation ``R`` (None: level)."""
+        body = self.model.body("swing").id
+        r = np.eye(3) if rotation is None else np.asarray(rotation, float)
+        self.model.body_pos[body] = r @ self._swing_pos
+        mujoco.mju_mat2Quat(self.model.body_quat[body], r.reshape(-1))
 
     def close(self) -> None:
         self.renderer.close()

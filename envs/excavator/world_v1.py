@@ -48,7 +48,9 @@ from motiongym.envs.excavator.world import HORIZON, POUR_NZ, POUR_TIME, Excavato
 
 BISECTIONS = 6
 SELF_HORIZON = 0.3  # m: self clearance exact below this
-UNDER_REACH = 1.3  # m: how far the underside samples lie below the arm points, at most
+UNDER_REACH = 1.3  # m: how far any body (bucket box: 1.12 m) reaches from the arm's polyline
+PARTS = ("boom", "stick", "bucket")  # the arm's links, in the order of its polyline
+HOUSE_RADIUS = 3.5  # m: house and tracks lie within this of the swing axis (3.13 m, 0.3 m tilt)
 # The bucket shell's underside in the bucket frame: (fraction of L4 along u, m behind the opening).
 SHELL = ((0.0, 0.75), (0.6, 0.9), (0.85, 0.55))
 SHELL_INSET = 0.1  # m: shell points this far inside the side plates (one cell of the map)
@@ -61,20 +63,39 @@ class Pose:
     corners, boom and stick bottoms, bucket shell), computed when asked.
     """
 
-    __slots__ = ("q", "points", "tip", "beta", "n", "u", "lat", "edge", "_world")
+    __slots__ = (
+        "q",
+        "points",
+        "tip",
+        "beta",
+        "n",
+        "u",
+        "lat",
+        "edge",
+        "low_arm",
+        "low_edge",
+        "_world",
+    )
 
     def __init__(self, q, world) -> None:
         self.q, self._world = q, world
-        m, rot = world.m, world._rot
+        m, r = world.m, world.rotation
         q1, q2, q3, q4 = q
         pts = arm_points(q1, q2, q3, q4, m)
         c1, s1 = math.cos(q1), math.sin(q1)
         beta = q2 + q3 + q4
         cb, sb = math.cos(beta), math.sin(beta)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
-        if rot is not None:
-            pts = tuple(rot(p) for p in pts)
-            n, u, lat = rot(n), rot(u), rot(lat)
+        if r is not None:
+            (a, b, c), (d, e, f), (g, h, i) = r
+            pts, n, u, lat = (
+                tuple(
+                    (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+                    for x, y, z in vectors
+                )
+                for vectors in (pts, (n,), (u,), (lat,))
+            )
+            n, u, lat = n[0], u[0], lat[0]
         self.points, self.tip, self.beta = pts, pts[3], beta
         self.n, self.u, self.lat = n, u, lat
         tip, half = pts[3], 0.5 * m.bucket_width - 0.05
@@ -84,10 +105,15 @@ class Pose:
             tip,
             (tip[0] - lx, tip[1] - ly, tip[2] - lz),
         )
+        # Heights above the ground plane: of the lowest arm point past the foot, and the edge.
+        gx, gy = world._gx, world._gy
+        self.low_arm = min(p[2] - gx * p[0] - gy * p[1] for p in pts[1:])
+        self.low_edge = tip[2] - gx * tip[0] - gy * tip[1] - abs(lz) - abs(gx * lx + gy * ly)
 
     def under(self) -> list[tuple[float, float, float]]:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
-        m, rot = self._world.m, self._world._rot
+        world = self._world
+        m, rot = world.m, world._rot if world.rotation is not None else None
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
         out = [
@@ -119,16 +145,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
 
     def reset(self, scene, q0) -> None:
         base = tuple(scene.base)
-        if base == (0.0, 0.0, 0.0):
-            self.rotation, self._rot = None, None
-        else:
-            r = base_rotation(*base).tolist()
-            self.rotation = r
-            self._rot = lambda v: (  # noqa: E731
-                r[0][0] * v[0] + r[0][1] * v[1] + r[0][2] * v[2],
-                r[1][0] * v[0] + r[1][1] * v[1] + r[1][2] * v[2],
-                r[2][0] * v[0] + r[2][1] * v[1] + r[2][2] * v[2],
-            )
+        self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
         self.self_clear = math.inf
         self.ground_contact = 0.0
         self.cut_force = 0.0
@@ -136,6 +153,15 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self.pushed = 0.0
         pipe, truck = scene.pipe, scene.truck
         self._pipe_body = bodies.Capsule(pipe.a, pipe.b, pipe.radius)
+        self._pipe_top = max(pipe.a[2], pipe.b[2]) + pipe.radius
+        self._truck_centre = (truck.cx, truck.cy)
+        self._truck_radius = math.hypot(truck.half_length, truck.half_width)
+        self._axis = (-self.m.L0, 0.0)
+        # The house stays within HOUSE_RADIUS of the axis: its bound to the truck is fixed.
+        self._house_truck = (
+            math.hypot(truck.cx + self.m.L0, truck.cy) - self._truck_radius - HOUSE_RADIUS
+        )
+        self._house_top = bodies.HOUSE[2][1] + 0.35  # + the tilt's lift at 3.5 m
         d = tuple(b - a for a, b in zip(pipe.a, pipe.b, strict=True))
         self._pipe_line3 = (pipe.a, d, 1.0 / max(sum(x * x for x in d), 1e-12))
         c, s = math.cos(truck.yaw), math.sin(truck.yaw)
@@ -245,6 +271,12 @@ class ExcavatorWorldV1(ExcavatorWorld):
         return self.terrain.volume() + (self.fill + self.truck_soil) / self.m.swell
 
     # --------------------------------------------------------------- physics
+    def _rot(self, v) -> tuple[float, float, float]:
+        """``R v``: a vector of frame M in frame O (the base rotation)."""
+        (a, b, c), (d, e, f), (g, h, i) = self.rotation
+        x, y, z = v
+        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+
     def _pose(self, q) -> Pose:
         return Pose(q, self)
 
@@ -255,17 +287,13 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._pose_now = pose
         self.points, self.tip, self.beta = pose.points, pose.tip, pose.beta
 
-    def _relief(self, p) -> float:
-        """Height of ``p`` above the base's ground plane (m)."""
-        return p[2] - self._gx * p[0] - self._gy * p[1]
-
     def _edge_depth(self, pose: Pose) -> float:
         """Largest soil depth over the cutting edge (m; negative: above the ground).
 
         Far above the ground (the edge higher over the ground plane than the
         highest relief) a negative bound is returned without reading the map.
         """
-        gap = min(self._relief(p) for p in pose.edge) - self._relief_max
+        gap = pose.low_edge - self._relief_max
         if gap > 0.0:
             return -gap
         h = self.terrain.height_at
@@ -278,8 +306,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
         house's corners at least ``0.95 - 3 tan(tilt)`` above the plane: above
         the highest relief by more, a negative bound is returned.
         """
-        low = min(self._relief(p) for p in pose.points[1:]) - UNDER_REACH
-        gap = min(low, self._house_relief) - self._relief_max
+        low = pose.low_arm - UNDER_REACH
+        gap = (low if low < self._house_relief else self._house_relief) - self._relief_max
         if gap > 0.0:
             return -gap
         h = self.terrain.height_at
@@ -333,55 +361,68 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 self._deposit(x, y, amount / self.m.swell)
 
     def _clearances(self) -> None:
-        """Exact body distances below the horizons, bounding-sphere lower bounds above.
+        """Exact body distances below the horizons, lower bounds above.
 
         Pipe and truck: exact below ``HORIZON`` (1 m; the house against the
         truck below ``SELF_HORIZON``); self: exact below ``SELF_HORIZON``
-        (0.3 m). A body is built only when a bound is under its horizon.
+        (0.3 m). Each part's bound, cheapest first: its segment of the arm's
+        polyline (the bucket's body lies within ``UNDER_REACH`` of it, a
+        link's within its radius; house and tracks within ``HOUSE_RADIUS``
+        of the swing axis) against the obstacle's bounding circle in plan
+        and its top; the bucket's bounding sphere next; a body is built only
+        when its bound is under its horizon.
         """
-        spheres = self._spheres()
-        parts: dict = {}
-
-        def part(name):
-            if name == "tracks":
-                return self._tracks_box
-            if name not in parts:
-                parts.update(self._bodies((name,)))
-            return parts[name]
-
+        pts = self.points
+        reach = (bodies.BOOM_RADIUS, bodies.STICK_RADIUS, UNDER_REACH)
+        cache: dict = {}
         best = math.inf
-        for name in ("boom", "stick", "bucket"):
-            c, r = spheres[name]
-            d = self._pipe_gap(c) - r
+        for k, name in enumerate(PARTS):
+            d = min(pts[k][2], pts[k + 1][2]) - reach[k] - self._pipe_top
             if d < HORIZON:
-                d = bodies.distance(part(name), self._pipe_body)
+                d = self._exact(cache, name, self._pipe_body, self._pipe_gap, HORIZON)
             best = d if d < best else best
         self.pipe_clear = best
-        best = math.inf
-        for name, horizon in (
-            ("boom", HORIZON),
-            ("stick", HORIZON),
-            ("bucket", HORIZON),
-            ("house", SELF_HORIZON),
-        ):
-            c, r = spheres[name]
-            d = self._truck_body.gap(c) - r
-            if d < horizon:
-                d = bodies.distance(part(name), self._truck_body)
+        cx, cy = self._truck_centre
+        best = self._house_truck
+        if best < SELF_HORIZON:
+            best = self._exact(cache, "house", self._truck_body, self._truck_body.gap, SELF_HORIZON)
+        for k, name in enumerate(PARTS):
+            plan = _plan_gap(pts[k], pts[k + 1], cx, cy) - self._truck_radius
+            above = min(pts[k][2], pts[k + 1][2]) - self.truck.height
+            d = max(plan, above) - reach[k]
+            if d < HORIZON:
+                d = self._exact(cache, name, self._truck_body, self._truck_body.gap, HORIZON)
             best = d if d < best else best
         self.truck_clear = best
+        ax, ay = self._axis
         best = math.inf
-        for a, b in bodies.SELF_PAIRS:
-            c, r = spheres[a]
-            if b == "tracks":
-                d = self._tracks_box.gap(c) - r
-            else:
-                cb, rb = spheres[b]
-                d = math.dist(c, cb) - r - rb
+        for k, name in ((1, "stick"), (2, "bucket")):
+            plan = _plan_gap(pts[k], pts[k + 1], ax, ay) - HOUSE_RADIUS
+            above = min(pts[k][2], pts[k + 1][2]) - self._house_top
+            d = max(plan, above) - reach[k]
             if d < SELF_HORIZON:
-                d = bodies.distance(part(a), part(b))
+                d = min(
+                    self._exact(cache, name, self._part(cache, other), None, SELF_HORIZON)
+                    for other in ("tracks", "house")
+                )
             best = d if d < best else best
         self.self_clear = best
+
+    def _exact(self, cache: dict, name: str, other, gap, horizon: float) -> float:
+        """Distance of part ``name`` to ``other``; the bucket's sphere bound first."""
+        if name == "bucket" or name == "house":
+            c, r = self._sphere(name)
+            d = (gap(c) if gap is not None else other.gap(c)) - r
+            if d >= horizon:
+                return d
+        return bodies.distance(self._part(cache, name), other)
+
+    def _part(self, cache: dict, name: str):
+        if name == "tracks":
+            return self._tracks_box
+        if name not in cache:
+            cache.update(self._bodies((name,)))
+        return cache[name]
 
     def _pipe_gap(self, c) -> float:
         """Distance from the point ``c`` to the pipe's surface (a lower bound's core)."""
@@ -397,26 +438,31 @@ class ExcavatorWorldV1(ExcavatorWorld):
             self.points, self.q[0], self.rotation, self.m.bucket_width, self.m.L0, names
         )
 
-    def _spheres(self) -> dict:
-        """Bounding spheres ``(centre, radius)`` of the five bodies of :mod:`.bodies`."""
-        foot, stick_pin, pin, tip = self.points
-        pose = self._pose_now
+    def _sphere(self, name: str) -> tuple[tuple[float, float, float], float]:
+        """Bounding sphere ``(centre, radius)`` of the bucket's or the house's body."""
         m = self.m
-        spheres = {
-            "boom": (_mid(foot, stick_pin), 0.5 * m.L2 + bodies.BOOM_RADIUS),
-            "stick": (_mid(stick_pin, pin), 0.5 * m.L3 + bodies.STICK_RADIUS),
-        }
-        along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
-        u, n = pose.u, pose.n
-        centre = tuple(pin[i] + along * u[i] - back * n[i] for i in range(3))
-        half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
-        spheres["bucket"] = (centre, math.sqrt(sum(h * h for h in half)))
+        if name == "bucket":
+            pin, pose = self.points[2], self._pose_now
+            along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
+            u, n = pose.u, pose.n
+            centre = tuple(pin[i] + along * u[i] - back * n[i] for i in range(3))
+            half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
+            return centre, math.sqrt(sum(h * h for h in half))
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
         (x0, x1), (y0, y1), (z0, z1) = bodies.HOUSE
         x, y = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
         house = (-m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, 0.5 * (z0 + z1))
-        spheres["house"] = (self._rot(house) if self._rot else house, self._house_radius)
-        return spheres
+        return (self._rot(house) if self.rotation else house), self._house_radius
+
+
+def _plan_gap(a, b, x: float, y: float) -> float:
+    """Plan-view distance from the point ``(x, y)`` to the segment ``a b``."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    px, py = x - a[0], y - a[1]
+    length2 = dx * dx + dy * dy
+    t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
+    t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+    return math.hypot(px - t * dx, py - t * dy)
 
 
 def _mid(a, b) -> tuple[float, float, float]:

@@ -18,9 +18,10 @@ from motiongym.envs.excavator import world as base  # noqa: E402
 from motiongym.envs.excavator.obstacles import pipe_clearance, truck_clearance  # noqa: E402
 
 IDS = ("motiongym/ExcavatorReach-v0", "motiongym/Excavator-v0")
+ALL_IDS = (*IDS, "motiongym/ExcavatorReach-v1", "motiongym/Excavator-v1")
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", ALL_IDS)
 def test_api_checks(env_id):
     env = gym.make(env_id, render_mode="rgb_array")
     check_env(env.unwrapped)
@@ -28,7 +29,7 @@ def test_api_checks(env_id):
     env.close()
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", ALL_IDS)
 def test_determinism_reward_terms_and_bounds(env_id):
     def rollout(seed):
         env = gym.make(env_id)
@@ -53,7 +54,7 @@ def test_determinism_reward_terms_and_bounds(env_id):
     assert not np.array_equal(rollout(7)[0], rollout(8)[0])
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", ALL_IDS)
 def test_bad_input_raises(env_id):
     env = gym.make(env_id).unwrapped
     env.reset(seed=0)
@@ -98,7 +99,7 @@ def test_bad_keyword_arguments_name_the_argument(env_id, kwargs, name):
         gym.make(env_id, **kwargs)
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", ALL_IDS)
 def test_step_and_render_before_reset_are_a_clear_error(env_id):
     env = gym.make(env_id, render_mode="rgb_array").unwrapped
     with pytest.raises(RuntimeError, match="reset"):
@@ -107,7 +108,7 @@ def test_step_and_render_before_reset_are_a_clear_error(env_id):
         env.render()
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", ALL_IDS)
 def test_pickle_and_render(env_id):
     env = gym.make(env_id, render_mode="rgb_array", render_size=(120, 160))
     env.reset(seed=3)

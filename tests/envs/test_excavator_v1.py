@@ -293,3 +293,47 @@ def test_machine_on_a_slope_is_the_papers_base_pose(env_id):
                 corner[2], abs=0.02
             )
     assert np.std(rolls) > 0.01
+
+
+# ----------------------------------------------------------------- ablations
+def test_ablation_without_the_cutting_cone_a_heel_first_push_fills(monkeypatch):
+    from motiongym.envs.excavator import digging
+
+    monkeypatch.setattr(digging, "CUT_CONE", -1.0)  # every motion into the soil cuts
+    m = gym.make("motiongym/Excavator-v1").unwrapped.m
+    env = _env(q0=_pose((6.0, 0.0, 0.01), -1.6, m))
+    info = _drive(env, (0.5, 0.0, -0.15), seconds=3.0)
+    assert info["bucket_fill"] > 0.1  # the v0 behaviour the issue reported
+
+
+def test_ablation_without_the_stall_the_machine_cuts_beyond_its_force():
+    m = gym.make("motiongym/Excavator-v1").unwrapped.m
+    env = _env(q0=_pose((7.0, 0.0, -1.6), -1.0, m), machine={"dig_force": 1e7})
+    x0 = env.world.tip[0]
+    _drive(env, (-0.5, 0.0, 0.0), seconds=1.0)
+    assert x0 - env.world.tip[0] > 0.2
+
+
+def test_ablation_swell_one_counts_bank_volume():
+    m = gym.make("motiongym/Excavator-v1").unwrapped.m
+    env = _env(q0=_pose((7.5, 0.0, 0.01), -1.0, m), machine={"swell": 1.0})
+    _drive(env, (-0.35, 0.0, -0.2), seconds=1.5)
+    info = _drive(env, (-0.5, 0.0, 0.0), beta_rate=-0.3, seconds=2.0)
+    assert info["bucket_fill"] == pytest.approx(-env.world.terrain.volume(), rel=1e-9)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_random_play_conserves_soil_and_keeps_parts_out_of_the_ground(seed):
+    env = gym.make("motiongym/Excavator-v1").unwrapped
+    env.reset(seed=seed)
+    world = env.world
+    total = world.soil_volume()
+    rng = np.random.default_rng(seed)
+    for _ in range(300):
+        _, _, terminated, _, info = env.step(rng.uniform(-1, 1, 4).astype(np.float32))
+        assert world.soil_volume() == pytest.approx(total, abs=1e-9)
+        assert world._penetration(world._pose_now) < 0.05
+        assert 0.0 <= info["bucket_fill"] <= env.m.bucket_capacity + 1e-12
+        if terminated:
+            env.reset(seed=seed + 10)
+            total = world.soil_volume()
