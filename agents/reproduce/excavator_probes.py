@@ -126,12 +126,13 @@ class _World:
             raise RuntimeError(f"probe pose {tip}, beta={beta}: {result.reason}")
         return result.q
 
-    def run(self, q0, goals, steps: int) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-        """One episode from ``q0`` tracking ``goals`` for at most ``steps`` steps."""
+    def run(self, q0, goals, steps: int) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+        """One episode from ``q0`` tracking ``goals`` for at most ``steps`` steps: the
+        trace, and the terrain's heights when the bucket first was full and at the end."""
         env = _make(self.env_id, max_episode_steps=steps)
         policy = JointGoals(*self.space, goals, self.m, self.dt)
         trace: list[dict[str, Any]] = []
-        heights: list[np.ndarray] = []
+        heights: dict[str, Any] = {"full": None}
 
         def hook(step) -> None:
             q = step.next_observation[layout("dig")["q"]]
@@ -147,13 +148,13 @@ class _World:
                     "pipe_contact": float(step.info["pipe_contact"]),
                 }
             )
-            heights.append(np.array(world.world.terrain.h))
+            if heights["full"] is None and trace[-1]["fill"] >= self.m.bucket_capacity - 1e-9:
+                heights["full"] = np.array(world.world.terrain.h)
 
-        episode = run_episode(env, policy, self.seed, hook=hook, options={"q0": np.asarray(q0)})
+        run_episode(env, policy, self.seed, hook=hook, options={"q0": np.asarray(q0)})
+        heights["end"] = np.array(env.unwrapped.world.terrain.h)
         env.close()
-        for row, h in zip(trace, heights, strict=True):
-            row["heights"] = h
-        return episode, trace
+        return trace, heights
 
 
 def heel_first_push(world: _World) -> dict[str, Any]:
@@ -163,7 +164,7 @@ def heel_first_push(world: _World) -> dict[str, Any]:
     for r in np.arange(5.75, 7.01, 0.25):
         q = world.pose(float(r), 0.5, beta, q)
         goals.append(q)
-    _, trace = world.run(q0, goals, 80)
+    trace, _ = world.run(q0, goals, 80)
     moved = math.dist(trace[0]["tip"], trace[-1]["tip"])
     fill = trace[-1]["fill"]
     return {"fill_m3": fill, "tip_moved_m": moved, "physical": fill < FILL_NONE}
@@ -174,7 +175,7 @@ def sideways_swing(world: _World) -> dict[str, Any]:
     goal = q0.copy()
     goal[0] += 3.0  # more than 1 s at the swing's full rate
     steps = int(round(1.0 / world.dt))
-    _, trace = world.run(q0, [goal], steps)
+    trace, _ = world.run(q0, [goal], steps)
     fill = trace[-1]["fill"]
     return {
         "fill_m3": fill,
@@ -188,7 +189,7 @@ def curled_plunge(world: _World) -> dict[str, Any]:
     beta = -2.6  # curled: opening up
     q0 = world.pose(6.0, -0.3, beta)
     goals = [world.pose(6.0, 0.7, beta, q0)]
-    _, trace = world.run(q0, goals, 60)
+    trace, _ = world.run(q0, goals, 60)
     fill = trace[-1]["fill"]
     deepest = max(row["tip_depth"] for row in trace)
     return {"fill_m3": fill, "tip_depth_m": deepest, "physical": fill < FILL_NONE}
@@ -198,7 +199,7 @@ def boom_into_ground(world: _World) -> dict[str, Any]:
     q0 = np.array(world.m.q_rest)
     goal = q0.copy()
     goal[1] = world.m.q_min[1]
-    _, trace = world.run(q0, [goal], int(round(2.0 / world.dt)))
+    trace, _ = world.run(q0, [goal], int(round(2.0 / world.dt)))
     tip = max(row["tip_depth"] for row in trace)
     pin = max(row["pin_depth"] for row in trace)
     return {
@@ -218,7 +219,7 @@ def dragged_full_bucket(world: _World) -> dict[str, Any]:
         q = world.pose_at(np.array(wp.tip), wp.beta, q)
         goals.append(q)
     q0 = goals[0]
-    _, trace = world.run(q0, goals, 300)
+    trace, heights = world.run(q0, goals, 300)
     capacity = world.m.bucket_capacity
     full = next((k for k, row in enumerate(trace) if row["fill"] >= capacity - 1e-9), None)
     if full is None:
@@ -226,7 +227,7 @@ def dragged_full_bucket(world: _World) -> dict[str, Any]:
     after = trace[full:]
     in_soil = [row for row in after if row["tip_depth"] > 0.05]
     moved = sum(math.dist(a["tip"], b["tip"]) for a, b in itertools.pairwise(in_soil))
-    changed = float(np.abs(after[-1]["heights"] - after[0]["heights"]).sum()) * world.cell**2
+    changed = float(np.abs(heights["end"] - heights["full"]).sum()) * world.cell**2
     return {
         "full_at_step": full,
         "tip_moved_in_soil_after_full_m": moved,
