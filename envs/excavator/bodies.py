@@ -15,7 +15,7 @@ stick        capsule, radius 0.30 about stick pin - bucket pin (contains a
              0.45 x 0.30 section: half diagonal 0.27)
 bucket       box in the bucket frame: along the pin-to-tip axis ``u`` from
              -0.15 to ``L4`` + 0.05, behind the opening (``-n``, the shell's
-             bulge) from -0.05 to 0.90, across ``+-(bucket_width / 2 + 0.05)``
+             bulge) from -0.05 to 0.95 (shell and plate), across ``+-(bucket_width / 2 + 0.05)``
              (the cutting edge's full width and the side plates)
 house        box turning with the swing: ``x'`` (ahead along the swing
              azimuth) -2.8 to 1.0 (tail swing radius 2.8 m), ``y'`` +-1.4,
@@ -44,7 +44,7 @@ from motiongym.envs.geometry import segment_distance
 
 BOOM_RADIUS = 0.40
 STICK_RADIUS = 0.30
-BUCKET_BACK = 0.90  # m: the shell's bulge behind the opening
+BUCKET_BACK = 0.95  # m: the shell (0.90 m behind the opening) and its 5 cm plate
 BUCKET_SIDE = 0.05  # m: side plates beyond the cutting edge
 HOUSE = ((-2.8, 1.0), (-1.4, 1.4), (0.95, 2.95))  # x', y', z (m)
 TRACKS = ((-2.25, 2.25), (-1.5, 1.5), (0.0, 0.92))  # x, y, z (m, frame M)
@@ -132,6 +132,20 @@ def segment_to_box(a, b, box: Box) -> float:
     return segment_box_distance(box.local(a), box.local(b), low, box.half)
 
 
+def separation(p: Box, q: Box) -> float:
+    """A lower bound of the distance between two boxes: the widest gap between their
+    projections on the six face normals (separating-axis test; <= 0: not separated)."""
+    d = tuple(b - a for a, b in zip(p.centre, q.centre, strict=True))
+    best = -math.inf
+    for axis in (*p.axes, *q.axes):
+        along = abs(d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2])
+        for box in (p, q):
+            for h, a in zip(box.half, box.axes, strict=True):
+                along -= h * abs(a[0] * axis[0] + a[1] * axis[1] + a[2] * axis[2])
+        best = along if along > best else best
+    return best
+
+
 def box_to_box(p: Box, q: Box) -> float:
     """Distance between two boxes (0 when they overlap)."""
     if p.contains(q.centre) or q.contains(p.centre):
@@ -145,6 +159,13 @@ def box_to_box(p: Box, q: Box) -> float:
                 if d == 0.0:
                     return 0.0
     return best
+
+
+def lower_bound(p, q) -> float:
+    """A cheap lower bound of :func:`distance` (separating axes for two boxes)."""
+    if isinstance(p, Box) and isinstance(q, Box):
+        return separation(p, q)
+    return -math.inf
 
 
 def distance(p, q) -> float:

@@ -18,6 +18,7 @@ from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
 from motiongym.envs.core import (
+    ArgumentError,
     NeedsReset,
     check_options,
     check_render_mode,
@@ -120,7 +121,7 @@ class ExcavatorBase(NeedsReset, OwnsRenderer, gym.Env):
 
     def step(self, action):
         self._require_reset("step")
-        values = checked_box_action(action, (4,), "swing, boom, stick, bucket rates").tolist()
+        values = _checked_action(action)
         world = self.world
         world.advance(values)
         terms, success = self.task.step(world)
@@ -168,6 +169,18 @@ class ExcavatorBase(NeedsReset, OwnsRenderer, gym.Env):
 
             self._renderer = SceneRenderer(self.m, self.render_size)
         return self._renderer.render(self.world)
+
+
+_ACTION_SPACE = "Box(-1.0, 1.0, (4,), float32): swing, boom, stick, bucket rates"
+
+
+def _checked_action(action: Any) -> list[float]:
+    """The action as 4 floats: real numbers only (no complex, text or objects), shape
+    (4,), finite; values outside [-1, 1] are clipped by the world (Box convention)."""
+    kind = np.asarray(action).dtype.kind if not isinstance(action, str) else "U"
+    if kind not in "biuf":
+        raise ArgumentError(f"action must be an array in {_ACTION_SPACE}, got {action!r}")
+    return checked_box_action(action, (4,), _ACTION_SPACE).tolist()
 
 
 def _check_q0(name: str, value: Any) -> np.ndarray:

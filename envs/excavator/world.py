@@ -197,7 +197,11 @@ class ExcavatorWorld:
             self.truck_soil += amount
         else:
             self.spill += amount
-            self.terrain.deposit(x, y, amount)
+            self._spill_on_ground(x, y, amount)
+
+    def _spill_on_ground(self, x: float, y: float, amount: float) -> None:
+        """Soil poured beside the truck lands on the ground at ``(x, y)``."""
+        self.terrain.deposit(x, y, amount)
 
     def _clearances(self) -> None:
         """Pipe and truck clearance: cheap lower bounds first, exact when under HORIZON.

@@ -349,16 +349,11 @@ class ExcavatorWorldV1(ExcavatorWorld):
         """As v0, except while the edge touches the ground (the cut face holds the soil in)."""
         pose = self._pose_now
         if self.fill > 0.0 and pose.n[2] < POUR_NZ and self._edge_depth(pose) < -DEPTH_TOLERANCE:
-            amount = min(self.fill, self.m.bucket_capacity * self.dt / POUR_TIME)
-            spill0 = self.spill
-            self.fill -= amount
-            pin = self.points[2]
-            x, y = 0.5 * (pin[0] + self.tip[0]), 0.5 * (pin[1] + self.tip[1])
-            if self.truck.contains_xy(x, y) and min(pin[2], self.tip[2]) > self.truck.height:
-                self.truck_soil += amount
-            else:
-                self.spill = spill0 + amount
-                self._deposit(x, y, amount / self.m.swell)
+            self._pour(min(self.fill, self.m.bucket_capacity * self.dt / POUR_TIME))
+
+    def _spill_on_ground(self, x: float, y: float, amount: float) -> None:
+        """Loose soil (m3) returns to the ground as bank volume, ``amount / swell``."""
+        self._deposit(x, y, amount / self.m.swell)
 
     def _clearances(self) -> None:
         """Exact body distances below the horizons, lower bounds above.
@@ -409,12 +404,18 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self.self_clear = best
 
     def _exact(self, cache: dict, name: str, other, gap, horizon: float) -> float:
-        """Distance of part ``name`` to ``other``; the bucket's sphere bound first."""
+        """Distance of part ``name`` to ``other``; for a box, its sphere's and its
+        separating axes' bounds first (the bound is returned when not under ``horizon``)."""
         if name == "bucket" or name == "house":
             c, r = self._sphere(name)
             d = (gap(c) if gap is not None else other.gap(c)) - r
             if d >= horizon:
                 return d
+            body = self._part(cache, name)
+            d = bodies.lower_bound(body, other)
+            if d >= horizon:
+                return d
+            return bodies.distance(body, other)
         return bodies.distance(self._part(cache, name), other)
 
     def _part(self, cache: dict, name: str):

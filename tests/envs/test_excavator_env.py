@@ -62,6 +62,9 @@ def test_bad_input_raises(env_id):
         env.step(np.zeros(3))
     with pytest.raises(ValueError, match="finite"):
         env.step(np.array([0.0, np.nan, 0.0, 0.0]))
+    for bad in (np.array([1j, 0, 0, 0]), "1111", ["a", "b", "c", "d"], np.zeros((1, 4)), 1.0):
+        with pytest.raises(ValueError, match="Box"):
+            env.step(bad)
     with pytest.raises(ValueError, match="unknown reset option"):
         env.reset(options={"target": 1})
     with pytest.raises(ValueError, match="q0"):

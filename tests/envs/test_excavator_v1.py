@@ -337,3 +337,43 @@ def test_random_play_conserves_soil_and_keeps_parts_out_of_the_ground(seed):
         if terminated:
             env.reset(seed=seed + 10)
             total = world.soil_volume()
+
+
+def _random_box(rng):
+    a = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    return bodies.Box(
+        tuple(rng.uniform(-2, 2, 3)), tuple(map(tuple, a)), tuple(rng.uniform(0.2, 1.0, 3))
+    )
+
+
+def test_box_distance_against_sampled_surfaces_and_its_bound():
+    rng = np.random.default_rng(0)
+    grid = np.linspace(-1.0, 1.0, 9)
+    unit = np.array([(x, y, z) for x in grid for y in grid for z in grid])
+    for _ in range(30):
+        p, q = _random_box(rng), _random_box(rng)
+        exact = bodies.box_to_box(p, q)
+        assert bodies.separation(p, q) <= exact + 1e-9
+        points = [
+            np.array(b.centre) + (unit * b.half) @ np.array(b.axes) for b in (p, q)
+        ]  # points filling each box
+        gaps = np.linalg.norm(points[0][:, None] - points[1][None], axis=-1).min()
+        assert exact <= gaps + 1e-9
+        if exact > 0.0:  # the closest pair is within a grid step of the samples
+            assert gaps - exact < 0.25 * (max(p.half) + max(q.half))
+
+
+def test_bucket_body_contains_the_bucket():
+    m = gym.make("motiongym/Excavator-v1").unwrapped.m
+    rng = np.random.default_rng(1)
+    env = _env(q0=m.q_ready)
+    for q in rng.uniform(m.q_min, m.q_max, size=(50, 4)):
+        env.world.q = list(q)
+        env.world._forward()
+        box = env.world._bodies(("bucket",))["bucket"]
+        pin = kin.link_frames(q, m)[3][:3, 3]
+        points = [pin, kin.forward(q, m)[:3, 3]]
+        points += [_bucket_corner(q, m, side, back) for side in (-1, 1) for back in (0.0, 0.85)]
+        points += list(env.world._pose_now.under()[-6:])  # the shell's underside samples
+        for point in points:
+            assert box.contains(point)
