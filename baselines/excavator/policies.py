@@ -111,6 +111,13 @@ class DigCyclePolicy(_ExcavatorPolicy):
     pipe, penetrate and drag), ``curl``/``lift`` (as soon as the bucket is
     full or the drag is over), ``carry``/``swing``/``dump`` (over the truck,
     then wait for the bucket to empty).
+
+    The path's style follows the environment's physics
+    (:data:`.bucket_path.V0_STYLE`, :data:`.bucket_path.V1_STYLE`); under v1
+    the plan is made in the base frame M (the slope's roll and pitch read from
+    the observation), the curl and lift rise along the world's vertical, and a
+    curl that the ground stops (no motion for ``STALL_STEPS`` steps) is
+    answered by raising the boom alone (stage ``raise``) and curling anew.
     """
 
     TASK = "dig"
