@@ -17,28 +17,36 @@ final poses (Fig. 5). It gives no other numbers. We run:
 3. Newton-Raphson beside Levenberg-Marquardt near the arm's singularity
    (stick almost in line with the boom); IK on unreachable targets: the
    reasons given, and that none is reported as converged;
-4. the dig-cycle scripted policy (the paper's announced next step) on seeded
-   scenes of ``motiongym/Excavator-v0``: bucket fill at the end of the dig,
-   soil delivered, spill, pipe contacts, cycle time;
-5. speed: IK solves per second, and env steps per second beside
+4. issue 16's IK probes: its flipped-bucket target, and 3,000 targets
+   sampled in Cartesian space (the reasons; no "no solution" reason where
+   the closed form has an in-limit solution; no wrong pose, both bucket axes,
+   reported converged) (:mod:`.excavator_ik`);
+5. the dig-cycle scripted policy (the paper's announced next step) on seeded
+   scenes of the dig world: bucket fill at the end of the dig, soil
+   delivered, spill, pipe contacts, cycle time;
+6. issue 16's probes of the world (:mod:`.excavator_probes`): what each does now;
+7. speed: IK solves per second, and env steps per second beside
    Gymnasium's ``Reacher-v5`` measured in the same run.
 """
 
 from __future__ import annotations
 
-import collections
 import json
-import math
 import pathlib
 import time
 from typing import Any
 
 import numpy as np
 
+from motiongym.agents.reproduce import excavator_ik as ik
+from motiongym.agents.reproduce import excavator_probes
 from motiongym.baselines.excavator import newton_raphson as nr
 from motiongym.envs.excavator.config import DEFAULT_MACHINE as M
-from motiongym.envs.excavator.kinematics import bucket_angle, forward, link_frames, swing_for_target
+from motiongym.envs.excavator.kinematics import link_frames
+from motiongym.envs.excavator.observation import layout
 
+DIG_IDS = ("motiongym/Excavator-v0", "motiongym/Excavator-v1")
+DELIVERED = 0.8  # m3 (loose in v1): the issue's target for one cycle
 V_NAMES = ("E(1,1)", "E(3,1)", "E(1,4)", "E(2,4)", "E(3,4)")
 
 
@@ -72,166 +80,86 @@ def paper_case() -> dict[str, Any]:
     }
 
 
-def random_poses(n: int, seed: int = 0) -> dict[str, Any]:
-    """IK on ``n`` reachable poses for several start/method choices."""
-    rng = np.random.default_rng(seed)
-    qs = rng.uniform(M.q_min, M.q_max, size=(n, 4))
-    variants = {
-        "newton_rest": dict(method="newton", align=False),
-        "newton_rest_aligned": dict(method="newton", align=True, align_bucket=True),
-        "newton_rest_swing_aligned": dict(method="newton", align=True),
-        "newton_projected": dict(method="newton", align=True, clamp=True),
-        "lm": dict(method="lm", align=True),
-    }
-    out = {}
-    for name, v in variants.items():
-        reasons, iterations, wrong = collections.Counter(), [], 0
-        start = time.perf_counter()
-        for q in qs:
-            h = forward(q, M)
-            q0 = np.array(M.q_rest)
-            if v["align"]:
-                q0[0] = swing_for_target(h[0, 3], h[1, 3], M)
-            if v.get("align_bucket"):
-                q0[3] = bucket_angle(q) - q0[1] - q0[2]
-            r = nr.solve(
-                h[:3, 3], bucket_angle(q), M, q0=q0, method=v["method"], clamp=v.get("clamp", False)
-            )
-            reasons[r.reason] += 1
-            if r.converged:
-                iterations.append(r.iterations)
-                hq = forward(r.q, M)
-                wrong += bool(np.linalg.norm(hq[:3, 3] - h[:3, 3]) > 1e-3)
-        elapsed = time.perf_counter() - start
-        out[name] = {
-            "n": n,
-            "converged_rate": reasons["converged"] / n,
-            "reasons": dict(reasons),
-            "iterations_median": float(np.median(iterations)) if iterations else None,
-            "iterations_max": int(max(iterations)) if iterations else None,
-            "wrong_pose_reported_converged": wrong,
-            "ms_per_solve": 1e3 * elapsed / n,
-        }
-    return out
+def dig_cycles(n: int, env_id: str, first_seed: int = 0) -> dict[str, Any]:
+    """The dig-cycle policy on ``n`` seeded scenes of ``env_id`` (seeds from ``first_seed``).
 
-
-def near_singular(n: int, seed: int = 2) -> dict[str, Any]:
-    """NR vs LM on poses with the stick within 0.005-0.1 rad of the boom line.
-
-    Boom and stick aligned is the arm's singularity; the real stick range
-    keeps 0.52 rad away from it, so this uses the machine with the stick's
-    upper limit moved to 0 (a geometric study, not a reachable pose).
+    Episodes run through :func:`~motiongym.agents.evaluate.run_episode`; a
+    hook times the policy, reads its public ``diagnostics()`` (the cut depth
+    it chose) and the zone's marked depth from the observation, and counts
+    the steps with a contact of each kind (ground, self: v1 only). A clean
+    delivery (the issue's target): at least :data:`DELIVERED` m3 in the
+    truck with no contact at all (pipe, truck, ground but the cut, self).
     """
-    from motiongym.envs.excavator.config import Machine
-
-    machine = Machine(q_max=(math.pi, M.q_max[1], 0.0, M.q_max[3]))
-    rng = np.random.default_rng(seed)
-    cases = []
-    for _ in range(n):
-        q = rng.uniform(machine.q_min, machine.q_max)
-        q[2] = -rng.uniform(0.005, 0.1)
-        cases.append(q)
-    out = {}
-    for method in ("newton", "lm"):
-        reasons, iterations = collections.Counter(), []
-        for q in cases:
-            h = forward(q, machine)
-            q0 = np.array(machine.q_rest)
-            q0[0] = swing_for_target(h[0, 3], h[1, 3], machine)
-            r = nr.solve(
-                h[:3, 3], bucket_angle(q), machine, q0=q0, method=method, max_iterations=50
-            )
-            reasons[r.reason] += 1
-            iterations += [r.iterations] if r.converged else []
-        out[method] = {
-            "n": n,
-            "converged_rate": reasons["converged"] / n,
-            "reasons": dict(reasons),
-            "iterations_median": float(np.median(iterations)) if iterations else None,
-        }
-    return out
-
-
-def unreachable(n: int, seed: int = 1) -> dict[str, Any]:
-    """Targets beyond reach (1-4 m past the boom+stick annulus) or inside it."""
-    rng = np.random.default_rng(seed)
-    reasons, false_success = collections.Counter(), 0
-    for k in range(n):
-        beta = rng.uniform(-math.pi, math.pi)
-        azimuth = rng.uniform(-math.pi, math.pi)
-        r = M.reach + rng.uniform(1.0, 4.0) if k % 2 == 0 else rng.uniform(0.0, 0.5)
-        z = rng.uniform(-2.0, 2.0) if k % 2 == 0 else rng.uniform(6.0, 8.0)
-        tip = np.array([r * math.cos(azimuth), r * math.sin(azimuth), z])
-        result = nr.solve(tip, beta, M, max_iterations=50)
-        reasons[result.reason] += 1
-        false_success += result.converged
-    return {"n": n, "reasons": dict(reasons), "reported_converged": false_success}
-
-
-def dig_cycles(n: int) -> dict[str, Any]:
-    """The dig-cycle policy on ``n`` seeded scenes of Excavator-v0."""
     import gymnasium as gym
 
+    from motiongym.agents.environments import resolved_env_kwargs
+    from motiongym.agents.evaluate import run_episode
     from motiongym.baselines.registry import make_policy
 
-    env_id = "motiongym/Excavator-v0"
     env = gym.make(env_id)
-    policy = make_policy(env_id, "dig-cycle", env.observation_space, env.action_space, {})
+    kwargs = resolved_env_kwargs(env_id, None)
+    policy = _TimedPolicy(
+        make_policy(env_id, "dig-cycle", env.observation_space, env.action_space, kwargs)
+    )
+    zone = layout("dig")["zone"]
     rows = []
-    policy_time, steps = 0.0, 0
-    for seed in range(n):
-        obs, info = env.reset(seed=seed)
-        start, done, cost, min_pipe, min_truck = True, False, 0.0, math.inf, math.inf
-        while not done:
-            t = time.perf_counter()
-            action, _ = policy.predict(obs, episode_start=start)
-            policy_time += time.perf_counter() - t
-            steps += 1
-            start = False
-            obs, _, terminated, truncated, info = env.step(action)
-            cost += info["cost"]
-            min_pipe = min(min_pipe, info["pipe_clearance"])
-            min_truck = min(min_truck, info["truck_clearance"])
-            done = terminated or truncated
-        memory = policy._memories[0]
-        rows.append(
-            {
-                "seed": seed,
-                "success": bool(info["is_success"]),
-                "dig_fill": info["dig_fill"],
-                "truck_soil": info["truck_soil"],
-                "spill": info["spill"],
-                "outside_zone": info["outside_zone"],
-                "pipe_contact": info["pipe_contact"],
-                "cost_steps": cost,
-                "min_pipe_clearance": min_pipe,
-                "min_truck_clearance": min_truck,
-                "cycle_time_s": info["elapsed"],
-                "cut_depth": memory.get("depth"),
-                "marked_depth": float(env.unwrapped.scene.zone.depth),
-            }
-        )
+    kinds = ("pipe_contact", "truck_contact", "ground_contact", "self_contact")
+    for seed in range(first_seed, first_seed + n):
+        seen: dict[str, Any] = dict.fromkeys(kinds, 0.0)
+
+        def hook(step, seen=seen) -> None:
+            seen["cut_depth"] = policy.diagnostics().get("cut_depth")
+            seen["marked_depth"] = float(step.observation[zone][4])
+            for kind in kinds:
+                seen[kind] += float(step.info.get(kind, 0.0))
+
+        episode = run_episode(env, policy, seed, hook=hook)
+        clean = episode["truck_soil"] >= DELIVERED and all(seen[k] == 0.0 for k in kinds)
+        rows.append({**episode, **seen, "success": bool(episode["is_success"]), "clean": clean})
     env.close()
 
     def stat(key: str) -> dict[str, float]:
         v = np.array([r[key] for r in rows], dtype=float)
         return {"mean": float(v.mean()), "min": float(v.min()), "max": float(v.max())}
 
+    limited = [r for r in rows if r["cut_depth"] is not None]
     return {
+        "env_id": env_id,
         "n": n,
+        "seeds": f"{first_seed}-{first_seed + n - 1}",
         "success_rate": float(np.mean([r["success"] for r in rows])),
+        "clean_delivery_rate": float(np.mean([r["clean"] for r in rows])),
+        "episodes_with_contact": {k: int(sum(r[k] > 0 for r in rows)) for k in kinds},
         "dig_fill_m3": stat("dig_fill"),
         "truck_soil_m3": stat("truck_soil"),
         "spill_m3": stat("spill"),
         "outside_zone_m3": stat("outside_zone"),
-        "pipe_contacts": int(sum(r["pipe_contact"] for r in rows)),
-        "cost_steps_total": float(sum(r["cost_steps"] for r in rows)),
-        "min_pipe_clearance_m": float(min(r["min_pipe_clearance"] for r in rows)),
-        "cycle_time_s": stat("cycle_time_s"),
-        "depth_limited_by_pipe": int(sum(r["cut_depth"] < r["marked_depth"] - 1e-9 for r in rows)),
-        "policy_ms_per_step": 1e3 * policy_time / max(steps, 1),
+        "cost_steps_total": float(sum(r["cost"] for r in rows)),
+        "min_pipe_clearance_m": float(min(r["pipe_clearance"] for r in rows)),
+        "cycle_time_s": stat("elapsed"),
+        "depth_limited_by_pipe": int(
+            sum(r["cut_depth"] < r["marked_depth"] - 1e-9 for r in limited)
+        ),
+        "policy_ms_per_step": 1e3 * policy.seconds / max(policy.calls, 1),
         "episodes": rows,
     }
+
+
+class _TimedPolicy:
+    """A predictor that times another one's ``predict`` (and passes ``diagnostics``)."""
+
+    def __init__(self, inner) -> None:
+        self.inner, self.seconds, self.calls = inner, 0.0, 0
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        start = time.perf_counter()
+        out = self.inner.predict(observation, state, episode_start, deterministic)
+        self.seconds += time.perf_counter() - start
+        self.calls += 1
+        return out
+
+    def diagnostics(self, index: int = 0) -> dict[str, Any]:
+        return self.inner.diagnostics(index)
 
 
 def speed(n_steps: int) -> dict[str, float]:
@@ -353,30 +281,51 @@ def _print(results: dict[str, Any]) -> None:
             f"{100 * r['converged_rate']:.1f} % conv. {r['reasons']}",
             "-",
         )
+    c = results["issue_case"]
+    table.add_row(
+        "issue's flipped bucket: converged / reason / q2+q3+q4",
+        f"{c['converged']} / {c['reason']} / {c['q2+q3+q4']:.3f} rad",
+        "-",
+    )
+    cart = results["cartesian_ik"]
+    for name in ("newton_rest", "newton_rest_swing_aligned", "fallback_chain"):
+        r = cart[name]
+        table.add_row(
+            f"{cart['n']} Cartesian targets ({cart['with_in_limit_solution']} solvable), {name}",
+            f"{100 * r['converged_rate_of_solvable']:.1f} % of solvable conv.; wrong "
+            f"{r['wrong_pose_reported_converged']}; 'no solution' for solvable "
+            f"{r['no_solution_reason_with_in_limit_solution']}; {r['reasons']}",
+            "-",
+        )
     u = results["unreachable"]
     table.add_row(
         "unreachable targets reported converged",
         f"{u['reported_converged']} / {u['n']}  {u['reasons']}",
         "-",
     )
-    d = results["dig_cycle"]
-    table.add_row(
-        "dig cycle success / pipe contacts",
-        f"{100 * d['success_rate']:.0f} % / {d['pipe_contacts']}",
-        "(next step announced)",
-    )
-    table.add_row(
-        "dig fill / delivered / spill / outside zone (mean m3)",
-        f"{d['dig_fill_m3']['mean']:.2f} / {d['truck_soil_m3']['mean']:.2f} / "
-        f"{d['spill_m3']['mean']:.3f} / {d['outside_zone_m3']['mean']:.3f}",
-        "-",
-    )
-    table.add_row(
-        "cycle time (mean, max s); depth limited by pipe",
-        f"{d['cycle_time_s']['mean']:.1f}, {d['cycle_time_s']['max']:.1f}; "
-        f"{d['depth_limited_by_pipe']} / {d['n']}",
-        "-",
-    )
+    for d in results["dig_cycle"].values():
+        table.add_row(
+            f"dig cycle {d['env_id']}: success / >= {DELIVERED} m3 with 0 contacts "
+            f"(seeds {d['seeds']})",
+            f"{100 * d['success_rate']:.1f} % / {100 * d['clean_delivery_rate']:.1f} %; "
+            f"episodes with contact {d['episodes_with_contact']}",
+            "(next step announced)",
+        )
+        table.add_row(
+            f"dig fill / delivered / spill / outside zone (mean m3), {d['env_id']}",
+            f"{d['dig_fill_m3']['mean']:.2f} / {d['truck_soil_m3']['mean']:.2f} / "
+            f"{d['spill_m3']['mean']:.3f} / {d['outside_zone_m3']['mean']:.3f}",
+            "-",
+        )
+        table.add_row(
+            f"cycle time (mean, max s); depth limited by pipe, {d['env_id']}",
+            f"{d['cycle_time_s']['mean']:.1f}, {d['cycle_time_s']['max']:.1f}; "
+            f"{d['depth_limited_by_pipe']} / {d['n']}",
+            "-",
+        )
+    for probes in results["probes"].values():
+        for row in excavator_probes.table_rows(probes):
+            table.add_row(*row)
     s = results["speed"]
     table.add_row("IK solves/s (paper case)", f"{s['ik_solves_per_s_paper_case']:.0f}", "-")
     table.add_row(
@@ -401,10 +350,15 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
     results: dict[str, Any] = {
         "machine": M.as_dict(),
         "paper_case": paper_case(),
-        "random_poses": random_poses(100 if quick else 1000),
-        "near_singular": near_singular(40 if quick else 200),
-        "unreachable": unreachable(40 if quick else 200),
-        "dig_cycle": dig_cycles(8 if quick else 100),
+        "random_poses": ik.random_poses(100 if quick else 1000),
+        "near_singular": ik.near_singular(40 if quick else 200),
+        "unreachable": ik.unreachable(40 if quick else 200),
+        "issue_case": ik.issue_case(),
+        "cartesian_ik": ik.cartesian_ik(300 if quick else 3000),
+        "dig_cycle": {
+            env_id: dig_cycles(8 if quick else 200, env_id, first_seed=1000) for env_id in DIG_IDS
+        },
+        "probes": {env_id: excavator_probes.run_probes(env_id) for env_id in DIG_IDS},
         "speed": speed(2000 if quick else 20000),
     }
     results["figures"] = _figures(out_dir, results["paper_case"])

@@ -14,6 +14,12 @@ POLICIES: dict[str, dict[str, str]] = {
     "motiongym/Excavator-v0": {
         "dig-cycle": "motiongym.baselines.excavator.policies:DigCyclePolicy",
     },
+    "motiongym/ExcavatorReach-v1": {
+        "newton-raphson-reach": "motiongym.baselines.excavator.policies:ReachPolicy",
+    },
+    "motiongym/Excavator-v1": {
+        "dig-cycle": "motiongym.baselines.excavator.policies:DigCyclePolicy",
+    },
 }
 
 # Planning times of `motiongym bench`: label -> ("module:function", goal in s).

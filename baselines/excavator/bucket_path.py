@@ -20,6 +20,12 @@ bucket opening faces ``(sin beta, -cos beta)`` in the boom plane):
 * swing: the same pose at the truck's azimuth (only the swing joint moves);
 * dump: bucket pin fixed, ``beta = -0.35`` (opening down: the soil pours).
 
+Attitude: wherever the tip is in the soil, it moves with the bucket opening
+ahead (opening normal . motion > 0): down and inwards while penetrating,
+inwards while dragging, along the opening while curling about the pin
+(curling turns the tip exactly along the opening normal). Nothing cuts heel
+first or sideways (tested).
+
 Pipe: the cut depth is the zone's marked depth, or less where the pipe runs
 within reach of the strip in plan: then the bucket's lowest point (tip minus
 the bucket radius) stays ``safety + 0.25 m`` above the pipe's top.
@@ -41,6 +47,47 @@ BETA_CARRY = -2.6
 BETA_DUMP = -0.35
 PIPE_MARGIN = 0.25  # m beyond the safety distance
 DRAG_STEP = 0.25  # m
+CURL_STEP = 0.25  # rad
+
+
+@dataclass(frozen=True)
+class Style:
+    """How the bucket enters and leaves the soil (one per physics).
+
+    ``penetration_angle``: None for the v0 entry (straight from 0.3 m above
+    the far end to the cut depth 0.4 m inside it: a steep plunge), else the
+    descent (rad below horizontal) of a ramp from the surface at the far end
+    to the cut depth. ``beta_open``: bucket angle while entering.
+    ``r_stop``: the drag ends no nearer the swing axis than this (m).
+    ``curl_rise``: the pin rises this much per radian of curl (m/rad), in
+    steps of ``CURL_STEP`` (0: one waypoint, the pin fixed).
+    ``lift_inwards``: the pin moves this much toward the machine while lifting (m).
+    """
+
+    penetration_angle: float | None = None
+    beta_open: float = -1.4
+    r_stop: float = 0.0
+    curl_rise: float = 0.0
+    lift_inwards: float = 0.5
+
+
+V0_STYLE = Style()
+# Physics v1: a bucket's shell may not go deeper into the ground than it is, and
+# only the edge moving within 60 deg of the opening cuts. Entering on a 25 deg
+# ramp with the teeth turned out (beta -1.35: the opening 13 deg below the
+# horizontal, short of pouring at 17 deg; the shell's underside 0.34 m above
+# the edge and 0.49 m behind it, a 35 deg slope) keeps the shell over the ramp
+# the edge has cut; the pin rises while the
+# bucket curls (the shell swings down about the pin otherwise); the drag stops
+# where the curled bucket (its tip 1 m nearer the machine) stays clear of the
+# tracks' front (2.25 m) by 1 m.
+V1_STYLE = Style(
+    penetration_angle=math.radians(25.0),
+    beta_open=-1.35,
+    r_stop=4.3,
+    curl_rise=0.9,
+    lift_inwards=0.0,
+)
 
 
 @dataclass(frozen=True)
@@ -82,54 +129,84 @@ def dig_path(
     r_far: float,
     depth: float,
     surface,
+    style: Style = V0_STYLE,
 ) -> list[Waypoint]:
-    """Approach, penetrate, drag and curl waypoints along the ray at ``azimuth``.
+    """Approach, penetrate and drag waypoints along the ray at ``azimuth``.
 
     ``surface(r)`` gives the ground height at radius ``r`` on that ray (m).
     """
     c, s = math.cos(azimuth), math.sin(azimuth)
+    b_open = style.beta_open
 
     def at(r: float, z: float) -> tuple[float, float, float]:
         return (c * r, s * r, z)
 
-    start = r_far - 0.4
     path = [
-        Waypoint("approach", at(r_far, surface(r_far) + 2.0), BETA_OPEN),
-        Waypoint("approach", at(r_far, surface(r_far) + 0.3), BETA_OPEN),
-        Waypoint("penetrate", at(start, surface(start) - depth), BETA_OPEN),
+        Waypoint("approach", at(r_far, surface(r_far) + 2.0), b_open),
+        Waypoint("approach", at(r_far, surface(r_far) + 0.3), b_open),
     ]
-    n = max(int(math.ceil((start - r_near) / DRAG_STEP)), 1)
+    if style.penetration_angle is None:
+        start = r_far - 0.4
+        path.append(Waypoint("penetrate", at(start, surface(start) - depth), b_open))
+    else:
+        run = depth / math.tan(style.penetration_angle)
+        start = r_far - run
+        n = max(int(math.ceil(math.hypot(run, depth) / DRAG_STEP)), 1)
+        for k in range(1, n + 1):
+            r = r_far - run * k / n
+            path.append(Waypoint("penetrate", at(r, surface(r) - depth * k / n), b_open))
+    end = max(r_near, style.r_stop)
+    n = max(int(math.ceil((start - end) / DRAG_STEP)), 1)
     for k in range(1, n + 1):
-        r = start - (start - r_near) * k / n
-        beta = BETA_OPEN + (BETA_DRAG - BETA_OPEN) * k / n
+        r = start - (start - end) * k / n
+        beta = b_open + (BETA_DRAG - b_open) * k / n
         path.append(Waypoint("drag", at(r, surface(r) - depth), beta))
     return path
 
 
-def curl_lift_path(tip: np.ndarray, beta: float, surface_here: float, m: Machine) -> list[Waypoint]:
-    """Curl about the bucket pin, then lift the pin 0.5 m inwards and up.
+def curl_lift_path(
+    tip: np.ndarray,
+    beta: float,
+    surface_here: float,
+    m: Machine,
+    style: Style = V0_STYLE,
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0),
+) -> list[Waypoint]:
+    """Curl about the bucket pin, then lift the pin (``style``: inwards) and up.
 
-    The pin (``tip - L4 [cos beta, sin beta]`` in the boom plane) stays put
-    while the bucket turns to ``beta_carry`` (the policy clips joint goals to
-    the joint ranges); then it moves 0.5 m toward the machine and up until
-    the tip is 0.8 m above the surface.
+    The pin (``tip - L4 [cos beta, sin beta]`` in the boom plane) rises
+    ``style.curl_rise`` per radian while the bucket turns to ``beta_carry``
+    (the policy clips joint goals to the joint ranges); then it moves
+    ``style.lift_inwards`` toward the machine and up until the tip is 0.8 m
+    above the surface. "Up" is ``up`` (unit, frame M): on a slope the world's
+    vertical, along which the trench's walls stand (rising along the tilted
+    frame's z would carry the bucket sideways into them).
     """
     x, y, z = (float(v) for v in tip)
     r = math.hypot(x, y)
     c, s = (x / r, y / r) if r > 1e-9 else (1.0, 0.0)
-    pin_r = r - m.L4 * math.cos(beta)
-    pin_z = z - m.L4 * math.sin(beta)
+    pin = np.array([x, y, z]) - m.L4 * np.array(
+        [c * math.cos(beta), s * math.cos(beta), math.sin(beta)]
+    )
+    up_v = np.asarray(up, float)
 
-    def tip_at(pr: float, pz: float, b: float) -> tuple[float, float, float]:
-        tr = pr + m.L4 * math.cos(b)
-        return (c * tr, s * tr, pz + m.L4 * math.sin(b))
+    def tip_at(p: np.ndarray, b: float) -> tuple[float, float, float]:
+        return (
+            float(p[0] + c * m.L4 * math.cos(b)),
+            float(p[1] + s * m.L4 * math.cos(b)),
+            float(p[2] + m.L4 * math.sin(b)),
+        )
 
-    lift_r = pin_r - 0.5
-    lift_z = max(pin_z + 0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY))
-    return [
-        Waypoint("curl", tip_at(pin_r, pin_z, BETA_CARRY), BETA_CARRY),
-        Waypoint("lift", tip_at(lift_r, lift_z, BETA_CARRY), BETA_CARRY),
-    ]
+    turn = abs(BETA_CARRY - beta)
+    n = max(int(math.ceil(turn / CURL_STEP)), 1) if style.curl_rise > 0.0 else 1
+    curl = []
+    for k in range(1, n + 1):
+        b = beta + (BETA_CARRY - beta) * k / n
+        curl.append(Waypoint("curl", tip_at(pin + style.curl_rise * turn * k / n * up_v, b), b))
+    curled = pin + style.curl_rise * turn * up_v
+    rise = max(0.5, surface_here + 0.8 - m.L4 * math.sin(BETA_CARRY) - curled[2]) / up_v[2]
+    lift = curled + rise * up_v - style.lift_inwards * np.array([c, s, 0.0])
+    return [*curl, Waypoint("lift", tip_at(lift, BETA_CARRY), BETA_CARRY)]
 
 
 def carry_dump_path(

@@ -20,22 +20,36 @@ the text; we follow the reconstruction of ``../shared/specs/excavator.md``:
 :func:`solve` runs eq. 13 (``method="newton"``) or its damped
 Levenberg-Marquardt variant (``method="lm"``: ``dq = (J^T J + lambda I)^-1 J^T V``
 with Marquardt's rule, lambda / 10 after an improving step, x 10 and the step
-refused otherwise) and reports whether it converged and, if not, why:
+refused otherwise).
 
-* ``"out_of_reach"``: no joint angles at all put the tip there with that bucket
-  angle (the bucket pin is outside the boom+stick annulus);
-* ``"joint_limits"``: the pose exists only outside the joint ranges, or the
-  iteration converged to a solution outside them;
-* ``"singular"``: ``J^T J`` became singular (condition number above 1e12);
-* ``"max_iterations"``: none of the above, the iteration budget ran out.
+Convergence is judged on the whole pose, not on ``V``: the tip position
+error below ``tol_position`` (m) and the rotation between the reached and
+the desired bucket frames (the angle of ``R_d^T R``, so both bucket axes:
+the pin-to-tip axis ``x`` and the joint axis ``z``) below ``tol_angle``
+(rad), with the joint angles (wrapped to (-pi, pi]) inside the limits. The
+paper's ``V`` carries only two entries of the ``x`` axis: it also vanishes
+with the swing turned half a turn and the bucket flipped over
+(``q2 + q3 + q4 = -pi - beta``, the same ``x`` axis with ``z`` reversed),
+which this check rejects. A wrong pose is never reported as converged.
+
+A failure says why, in two families (:data:`NO_SOLUTION`,
+:data:`FROM_START`), the first decided by the closed form
+(:func:`analytic_solutions`, both stick branches):
+
+* no in-limit solution exists (``IKResult.solution_exists`` False):
+  ``"out_of_reach"`` (no joint angles at all give the pose: the bucket pin is
+  outside the boom+stick annulus) or ``"joint_limits"`` (the pose exists only
+  outside the joint ranges);
+* an in-limit solution exists, the iteration did not reach it from this start
+  (``solution_exists`` True): ``"outside_limits"`` (it converged to the pose
+  with a joint outside its range), ``"flipped"`` (``V`` vanished with the
+  bucket frame turned about its ``x`` axis, see above), ``"singular"``
+  (``J^T J`` became singular, condition number above 1e12) or
+  ``"max_iterations"`` (the budget ran out).
 
 ``H(q)`` is evaluated with the closed form of eq. 4
 (:func:`~motiongym.envs.excavator.kinematics.tip_frame`, equal to the matrix
 product, tested); the final pose is checked with the matrix product itself.
-Convergence is judged on the pose, not on ``V``: tip position error below
-``tol_position`` (m) and bucket-angle error below ``tol_angle`` (rad), with
-the joint angles (wrapped to (-pi, pi]) inside the limits. A wrong pose is
-never reported as converged.
 """
 
 from __future__ import annotations
@@ -67,6 +81,9 @@ PAPER_REACH_FRACTION = 0.8
 PAPER_BETA = -math.pi / 8
 JACOBIANS = ("analytic", "numeric")
 _SINGULAR_COND = 1e12
+NO_SOLUTION = ("out_of_reach", "joint_limits")
+FROM_START = ("outside_limits", "flipped", "singular", "max_iterations")
+REASONS = ("converged", *NO_SOLUTION, *FROM_START)
 
 
 @dataclass
@@ -75,11 +92,12 @@ class IKResult:
 
     q: np.ndarray  # (4,) joint angles, wrapped to (-pi, pi]
     converged: bool
-    reason: str  # "converged", "out_of_reach", "joint_limits", "singular", "max_iterations"
+    reason: str  # one of REASONS
     iterations: int  # iterations run
     errors: np.ndarray  # (iterations + 1, 5) V before each iteration and after the last
     position_error: float  # m
-    angle_error: float  # rad
+    angle_error: float  # rad, rotation between the reached and the desired bucket frames
+    solution_exists: bool  # an in-limit solution exists (closed form; True when converged)
 
 
 def paper_target(m: Machine) -> tuple[np.ndarray, float]:
@@ -105,9 +123,15 @@ def error_vector(q: np.ndarray, h_d: np.ndarray, m: Machine, base: np.ndarray | 
 
 
 def _pose_errors(h: np.ndarray, h_d: np.ndarray) -> tuple[float, float]:
+    """Tip position error (m) and the rotation angle of ``R_d^T R`` (rad, both axes)."""
     pos = float(np.linalg.norm(h[:3, 3] - h_d[:3, 3]))
-    cos_angle = float(np.clip(h[:3, 0] @ h_d[:3, 0], -1.0, 1.0))
-    return pos, math.acos(cos_angle)
+    cos_angle = 0.5 * (float(np.sum(h[:3, :3] * h_d[:3, :3])) - 1.0)
+    return pos, math.acos(min(max(cos_angle, -1.0), 1.0))
+
+
+def _axis_error(h: np.ndarray, h_d: np.ndarray) -> float:
+    """Angle between the reached and the desired pin-to-tip (``x``) axes (rad)."""
+    return math.acos(min(max(float(h[:3, 0] @ h_d[:3, 0]), -1.0), 1.0))
 
 
 def jacobian(q: np.ndarray, m: Machine, base: np.ndarray | None = None) -> np.ndarray:
@@ -177,17 +201,28 @@ def analytic_solutions(
     return out
 
 
-def _diagnose(tip, beta, m, base, singular: bool) -> str:
+def solution_exists(tip, beta, m: Machine, base: np.ndarray | None = None) -> bool:
+    """Whether an in-limit solution exists (closed form, :func:`analytic_solutions`)."""
+    return any(within_limits(s, m) for s in analytic_solutions(tip, beta, m, base))
+
+
+def _diagnose(tip, beta, m, base, h, h_d, tols, singular: bool) -> tuple[str, bool]:
+    """``(reason, solution_exists)`` of a failed solve, see the module docstring."""
     solutions = analytic_solutions(tip, beta, m, base)
     if not solutions:
-        return "out_of_reach"
+        return "out_of_reach", False
     if not any(within_limits(s, m) for s in solutions):
-        return "joint_limits"
-    return "singular" if singular else "max_iterations"
+        return "joint_limits", False
+    pos, ang = _pose_errors(h, h_d)
+    if pos < tols[0] and ang < tols[1]:
+        return "outside_limits", True
+    if pos < tols[0] and _axis_error(h, h_d) < tols[1]:
+        return "flipped", True
+    return ("singular" if singular else "max_iterations"), True
 
 
 def pose_errors(q: np.ndarray, h_d: np.ndarray, m: Machine, base=None) -> tuple[float, float]:
-    """Tip position error (m) and bucket-axis angle error (rad) at ``q``."""
+    """Tip position error (m) and bucket-frame rotation error (rad, both axes) at ``q``."""
     return _pose_errors(forward(q, m, base), h_d)
 
 
@@ -215,7 +250,7 @@ def solve(
         q0: start (default: the machine's rest pose, as in the paper).
         base: ``H_M^O`` (default identity: base frame = reference frame).
         max_iterations: iteration budget (the paper runs 20).
-        tol_position, tol_angle: convergence tolerances (m, rad).
+        tol_position, tol_angle: convergence tolerances (m; rad, the bucket frame's rotation).
         method: "newton" (eq. 13) or "lm" (damped).
         jacobian_mode: "analytic" or "numeric" (central differences).
         stop_early: stop as soon as the tolerances are met (else run them all).
@@ -270,15 +305,14 @@ def solve(
             if pos < tol_position and ang < tol_angle:
                 break
     q = wrap(q)
-    pos, ang = pose_errors(q, h_d, m, base)
-    ok = pos < tol_position and ang < tol_angle
-    if ok and within_limits(q, m):
-        reason, converged = "converged", True
-    elif ok:
-        reason, converged = "joint_limits", False
+    h = forward(q, m, base)
+    pos, ang = _pose_errors(h, h_d)
+    if pos < tol_position and ang < tol_angle and within_limits(q, m):
+        reason, exists = "converged", True
     else:
-        reason, converged = _diagnose(tip, beta, m, base, singular), False
-    return IKResult(q, converged, reason, k, np.array(errors), pos, ang)
+        tols = (tol_position, tol_angle)
+        reason, exists = _diagnose(tip, beta, m, base, h, h_d, tols, singular)
+    return IKResult(q, reason == "converged", reason, k, np.array(errors), pos, ang, exists)
 
 
 def solve_paper_case() -> IKResult:
