@@ -19,8 +19,47 @@ from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import EVALUATION_SEED, Evaluation
 from motiongym.baselines.registry import UnknownPolicyError
 from motiongym.envs import ENV_IDS
+from motiongym.envs.core import ArgumentError
 
 DEFAULT_EPISODES = 10
+MAX_SEED = 2**32 - 1  # NumPy, Gymnasium and torch all take seeds in [0, 2**32)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with the command's own error style: one line, exit 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        print(f"motiongym: error: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _count(text: str) -> int:
+    """A positive whole number (episodes, timesteps)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {value}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text!r}") from None
+    if not 0 <= value <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"must be in [0, {MAX_SEED}], got {value}")
+    return value
+
+
+def _folder(text: str) -> Path:
+    """An output folder: it may not exist yet, but may not be a file."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    return path
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
@@ -40,6 +79,8 @@ def _evaluations(env_id: str, policies: list[str], args: argparse.Namespace) -> 
     from motiongym.agents.predictors import load_predictor, policy_label
 
     env_kwargs = _env_kwargs(args.env_kwargs)
+    if args.seed + args.episodes - 1 > MAX_SEED:
+        raise UsageError(f"--seed {args.seed} + --episodes {args.episodes} passes {MAX_SEED}")
     env = make_env(env_id, env_kwargs)
     seeds = range(args.seed, args.seed + args.episodes)
     results = []
@@ -139,13 +180,13 @@ def cmd_bench(args: argparse.Namespace) -> None:
 def _evaluation_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--episodes",
-        type=int,
+        type=_count,
         default=DEFAULT_EPISODES,
         help=f"episodes per policy (default {DEFAULT_EPISODES})",
     )
     parser.add_argument(
         "--seed",
-        type=int,
+        type=_seed,
         default=EVALUATION_SEED,
         help=f"seed of the first episode; episode i uses seed+i (default {EVALUATION_SEED})",
     )
@@ -157,7 +198,9 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
         help="keywords for gym.make (the environment's own, or max_episode_steps); "
         "values read as YAML",
     )
-    parser.add_argument("--out", type=Path, default=Path("results"), help="output folder")
+    parser.add_argument(
+        "--out", type=_folder, default=Path("results"), help="output folder (default results)"
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
         "--trust",
@@ -170,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     from motiongym.agents.model_files import algorithm_classes
     from motiongym.agents.reproduce import EXPERIMENTS
 
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="motiongym", description="Scripted and learned control of classic robot motion tasks."
     )
     commands = parser.add_subparsers(dest="command", required=True)
@@ -207,9 +250,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="an algorithm block of the config (default: its first, the tuned one)",
     )
     train.add_argument("--config", type=Path, help="YAML file (default: configs/<Name>-vN.yml)")
-    train.add_argument("--seed", type=int, default=0)
-    train.add_argument("--timesteps", type=int, help="override the config's n_timesteps")
-    train.add_argument("--out", type=Path, default=Path("runs"), help="where run folders go")
+    train.add_argument("--seed", type=_seed, default=0, help="training seed (default 0)")
+    train.add_argument("--timesteps", type=_count, help="override the config's n_timesteps")
+    train.add_argument(
+        "--out", type=_folder, default=Path("runs"), help="where run folders go (default runs)"
+    )
     train.add_argument("--no-progress", action="store_true", help="no progress bar")
     train.set_defaults(handler=cmd_train)
 
@@ -219,36 +264,45 @@ def build_parser() -> argparse.ArgumentParser:
     ship.add_argument(
         "run_dirs", type=Path, nargs="+", help="run folders written by motiongym train"
     )
-    ship.add_argument("--episodes", type=int, default=20, help="held-out evaluation episodes")
+    ship.add_argument(
+        "--episodes", type=_count, default=20, help="held-out evaluation episodes (default 20)"
+    )
     ship.set_defaults(handler=cmd_ship)
 
     benchmarks = commands.add_parser(
         "benchmarks", help="regenerate BENCHMARKS.md: scripted vs learned on every ID"
     )
-    benchmarks.add_argument("--episodes", type=int, default=20, help="held-out episodes")
+    benchmarks.add_argument(
+        "--episodes", type=_count, default=20, help="held-out episodes (default 20)"
+    )
     benchmarks.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
     benchmarks.set_defaults(handler=cmd_benchmarks)
 
     reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")
     reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))
     reproduce.add_argument("--quick", action="store_true", help="reduced protocol")
-    reproduce.add_argument("--out", type=Path, default=Path("results/reproduce"))
+    reproduce.add_argument("--out", type=_folder, default=Path("results/reproduce"))
     reproduce.set_defaults(handler=cmd_reproduce)
 
     bench = commands.add_parser("bench", help="throughput against references in the same run")
     bench.add_argument("ids", nargs="*", help="environment IDs (default: all)")
     bench.add_argument("--quick", action="store_true", help="shorter timings")
-    bench.add_argument("--out", type=Path, default=Path("results/bench"))
+    bench.add_argument("--out", type=_folder, default=Path("results/bench"))
     bench.set_defaults(handler=cmd_bench)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # a usage error, already printed on one line
+        if exit_.code == 2:
+            return 2
+        raise  # --help
     try:
         args.handler(args)
-    except (UsageError, UnknownPolicyError) as error:
+    except (UsageError, UnknownPolicyError, ArgumentError) as error:
         print(f"motiongym: error: {error}", file=sys.stderr)
         return 2
     return 0

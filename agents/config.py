@@ -52,6 +52,7 @@ from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
 from motiongym.agents.model_files import algorithm_classes
+from motiongym.envs.core import ArgumentError, check_choice, check_float, check_int
 
 RUN_SETTINGS: dict[str, Any] = {
     "n_envs": 1,
@@ -156,7 +157,68 @@ def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
         raise UsageError(f"{where}: 'deterministic' must be true or false")
     if config["vec_env"] not in VEC_ENVS:
         raise UsageError(f"{where}: vec_env must be one of {', '.join(VEC_ENVS)}")
+    try:
+        _check_values(config, classes[algo])
+    except ArgumentError as error:
+        raise UsageError(f"{where}: {error}") from error
     return config
+
+
+# Ranges of the run settings and of common constructor arguments: key -> check.
+_INT_RANGES: dict[str, tuple[int, int | None]] = {
+    "n_envs": (1, 1024),
+    "n_timesteps": (1, 10**11),
+    "eval_freq": (1, None),
+    "n_eval_episodes": (1, 100_000),
+    "checkpoint_freq": (1, None),
+    "n_steps": (2, None),
+    "batch_size": (1, None),
+    "n_epochs": (1, None),
+    "buffer_size": (1, None),
+    "learning_starts": (0, None),
+    "sde_sample_freq": (-1, None),
+    "stats_window_size": (1, None),
+}
+_FLOAT_RANGES: dict[str, tuple[float, float, bool]] = {  # low, high, low open
+    "learning_rate": (0.0, 10.0, True),
+    "gamma": (0.0, 1.0, True),
+    "gae_lambda": (0.0, 1.0, False),
+    "vf_coef": (0.0, 1e6, False),
+    "max_grad_norm": (0.0, 1e6, True),
+    "clip_range": (0.0, 10.0, True),
+    "tau": (0.0, 1.0, True),
+}
+
+
+def _check_values(config: dict[str, Any], algorithm: type) -> None:
+    """Types and ranges of the block's values, in the environments' message style."""
+    for key, (low, high) in _INT_RANGES.items():
+        if key in config:
+            check_int(key, config[key], low, high)
+    for key, (low, high, low_open) in _FLOAT_RANGES.items():
+        if key in config:
+            check_float(key, config[key], low, high, low_open=low_open)
+    for key in ("ent_coef", "target_kl", "clip_range_vf"):
+        value = config.get(key)
+        if value is not None and not (isinstance(value, str) and value.startswith("auto")):
+            check_float(key, value, 0.0, 1e6)
+    for key in ("train_freq", "gradient_steps"):
+        if key in config and not isinstance(config[key], (list, tuple)):
+            check_int(key, config[key], -1 if key == "gradient_steps" else 1)
+    check_choice("policy", config["policy"], sorted(algorithm.policy_aliases))
+    if not (isinstance(config["normalize"], (bool, dict))):
+        raise ArgumentError(
+            f"normalize must be true, false or a mapping, got {config['normalize']!r}"
+        )
+    arch = config["policy_kwargs"].get("net_arch")
+    layers = arch.values() if isinstance(arch, dict) else [arch] if arch is not None else []
+    for layer in layers:
+        if not isinstance(layer, list):
+            raise ArgumentError(f"net_arch must be a list of layer sizes, got {arch!r}")
+        for size in layer:
+            check_int("net_arch layer size", size, 1, 65_536)
+    if "log_std_init" in config["policy_kwargs"]:
+        check_float("log_std_init", config["policy_kwargs"]["log_std_init"], -20.0, 20.0)
 
 
 def algorithm_kwargs(config: dict[str, Any]) -> dict[str, Any]:

@@ -26,6 +26,7 @@ environment step; the evaluation callback runs one copy.
 from __future__ import annotations
 
 import shlex
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -160,55 +161,61 @@ def train(
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
     run_dir.mkdir(parents=True, exist_ok=True)
-    (run_dir / "command.txt").write_text(shlex.join(sys.argv) + "\n")
-    resolved = {"env_id": env_id, "algo": algo, "seed": seed, "config_file": str(config_path)}
-    (run_dir / CONFIG_FILE).write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
+    try:  # a run that fails before learning leaves no half-made folder
+        (run_dir / "command.txt").write_text(shlex.join(sys.argv) + "\n")
+        resolved = {"env_id": env_id, "algo": algo, "seed": seed, "config_file": str(config_path)}
+        (run_dir / CONFIG_FILE).write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
 
-    n_envs = config["n_envs"]
-    venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
-    eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
-    eval_venv = _normalize(eval_venv, config, False)
-    if algo == "maskableppo" and not venv.has_attr("action_masks"):
-        raise UsageError(
-            f"{env_id} with vec_env {config['vec_env']} gives no action masks for maskableppo"
-        )
-    algorithm = algorithm_classes()[algo]
-    try:
-        model = algorithm(
-            config["policy"],
-            venv,
-            policy_kwargs=policy_kwargs(config),
-            tensorboard_log=str(run_dir / "tb"),
-            seed=seed,
-            device="cpu",
-            verbose=0,
-            **algorithm_kwargs(config),
-        )
-    except AssertionError as error:  # SB3 checks the spaces with assertions
-        raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
-    eval_dir = run_dir / "eval"
-    if algo == "maskableppo":
-        from sb3_contrib.common.maskable.callbacks import MaskableEvalCallback as EvalCallbackClass
-    else:
-        EvalCallbackClass = EvalCallback
-    callbacks = [
-        EvalCallbackClass(
-            eval_venv,
-            eval_freq=max(config["eval_freq"] // venv.num_envs, 1),
-            # Every slot of the one evaluation env runs n_eval_episodes episodes.
-            n_eval_episodes=config["n_eval_episodes"] * eval_venv.num_envs,
-            best_model_save_path=str(eval_dir),
-            log_path=str(eval_dir),
-            deterministic=config["deterministic"],
-            verbose=0,
-        ),
-        CheckpointCallback(
-            save_freq=max(config["checkpoint_freq"] // venv.num_envs, 1),
-            save_path=str(run_dir / "checkpoints"),
-            name_prefix="model",
-            save_vecnormalize=bool(config["normalize"]),
-        ),
-    ]
+        n_envs = config["n_envs"]
+        venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
+        eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
+        eval_venv = _normalize(eval_venv, config, False)
+        if algo == "maskableppo" and not venv.has_attr("action_masks"):
+            raise UsageError(
+                f"{env_id} with vec_env {config['vec_env']} gives no action masks for maskableppo"
+            )
+        algorithm = algorithm_classes()[algo]
+        try:
+            model = algorithm(
+                config["policy"],
+                venv,
+                policy_kwargs=policy_kwargs(config),
+                tensorboard_log=str(run_dir / "tb"),
+                seed=seed,
+                device="cpu",
+                verbose=0,
+                **algorithm_kwargs(config),
+            )
+        except AssertionError as error:  # SB3 checks the spaces with assertions
+            raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
+        eval_dir = run_dir / "eval"
+        if algo == "maskableppo":
+            from sb3_contrib.common.maskable.callbacks import (
+                MaskableEvalCallback as EvalCallbackClass,
+            )
+        else:
+            EvalCallbackClass = EvalCallback
+        callbacks = [
+            EvalCallbackClass(
+                eval_venv,
+                eval_freq=max(config["eval_freq"] // venv.num_envs, 1),
+                # Every slot of the one evaluation env runs n_eval_episodes episodes.
+                n_eval_episodes=config["n_eval_episodes"] * eval_venv.num_envs,
+                best_model_save_path=str(eval_dir),
+                log_path=str(eval_dir),
+                deterministic=config["deterministic"],
+                verbose=0,
+            ),
+            CheckpointCallback(
+                save_freq=max(config["checkpoint_freq"] // venv.num_envs, 1),
+                save_path=str(run_dir / "checkpoints"),
+                name_prefix="model",
+                save_vecnormalize=bool(config["normalize"]),
+            ),
+        ]
+    except BaseException:
+        shutil.rmtree(run_dir, ignore_errors=True)
+        raise
     model.learn(
         total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
     )

@@ -199,3 +199,53 @@ def test_train_defaults_to_the_config_files_first_block(tmp_path):
     run_dir = train("motiongym/ExcavatorReach-v0", config_path=config, out_root=tmp_path)
     assert run_dir.name.startswith("a2c_seed0_")
     assert first_block(default_config_path("motiongym/Sweeper-v0")) == "maskableppo"
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["--seed", "-5"], "--seed: must be in [0, 4294967295], got -5"),
+        (["--seed", str(2**80)], "--seed: must be in [0, 4294967295]"),
+        (["--seed", "x"], "--seed: must be a whole number"),
+        (["--episodes", "0"], "--episodes: must be a whole number >= 1, got 0"),
+        (["--seed", str(2**32 - 1), "--episodes", "2"], "passes 4294967295"),
+        (["--env-kwargs", "map_name=bogus"], "map_name must be one of"),
+        (["--env-kwargs", "robot_width=2.5"], "robot_width must be an integer"),
+    ],
+)
+def test_bad_evaluation_arguments_are_one_line_and_exit_2(capsys, argv, expected):
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", *argv])
+    assert expected in err
+
+
+def test_out_on_a_file_is_refused_and_writes_nothing(capsys, tmp_path):
+    target = tmp_path / "a_file"
+    target.write_text("keep me")
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", "--out", str(target)])
+    assert "is a file, not a folder" in err and target.read_text() == "keep me"
+
+
+@pytest.mark.parametrize(
+    ("setting", "expected"),
+    [
+        ("n_envs: 0", "n_envs must be an integer in [1, 1024], got 0"),
+        ("n_timesteps: -5", "n_timesteps must be an integer"),
+        ("policy: 123", "policy must be one of"),
+        ("learning_rate: .nan", "learning_rate must be a finite number"),
+        ("gamma: 2", "gamma must be a finite number in (0.0, 1.0]"),
+        ("eval_freq: -1", "eval_freq must be an integer >= 1"),
+        ("checkpoint_freq: 0", "checkpoint_freq must be an integer >= 1"),
+        ("policy_kwargs: {net_arch: [-5]}", "net_arch layer size must be an integer"),
+    ],
+)
+def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, setting, expected):
+    config = tmp_path / "bad.yml"
+    block = {"n_timesteps": "64", "policy": "MultiInputPolicy", "n_steps": "32", "batch_size": "32"}
+    key = setting.split(":")[0]
+    block.pop(key, None)
+    lines = [f"  {k}: {v}" for k, v in block.items()] + [f"  {setting}"]
+    config.write_text("ppo:\n" + "\n".join(lines) + "\n")
+    out = tmp_path / "runs"
+    err = _error(capsys, ["train", SWEEPER, "--config", str(config), "--out", str(out)])
+    assert expected in err
+    assert not out.exists() or not any(out.rglob("*.yml"))
