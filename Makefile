@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 EPISODES ?= 10
 
-.PHONY: install demo test test-slow lint models benchmarks
+.PHONY: install demo test test-slow lint models benchmarks fuzz
 
 $(STAMP): pyproject.toml setup.py
 	python3 -m venv $(VENV)
@@ -26,6 +26,11 @@ test: $(STAMP)
 
 test-slow: $(STAMP)
 	MUJOCO_GL=egl $(BIN)/pytest -q -m slow
+
+# The full property-based hostile-input run (every ID, 60 examples per test and ID;
+# the default suite runs a fast slice); prints the counts per outcome.
+fuzz: $(STAMP)
+	MUJOCO_GL=egl MOTIONGYM_FUZZ=fuzz $(BIN)/pytest -q -s tests/fuzz
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

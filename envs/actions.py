@@ -23,7 +23,16 @@ def checked_box_action(action: Any, shape: tuple[int, ...], meaning: str) -> np.
         shape: the action space's shape.
         meaning: what the entries are, for the message (e.g. "one rate per joint").
     """
-    a = np.asarray(action, dtype=np.float64)
+    if np.iscomplexobj(action) or isinstance(action, (str, bytes)):
+        raise ValueError(
+            f"action must be real numbers of shape {shape} ({meaning}), got {action!r}"
+        )
+    try:
+        a = np.asarray(action, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"action must be real numbers of shape {shape} ({meaning}), got {action!r}"
+        ) from None
     if a.shape != shape:
         raise ValueError(f"action must have shape {shape} ({meaning}), got {a.shape}")
     if not math.isfinite(a.sum()):

@@ -28,6 +28,8 @@ from motiongym.baselines.dual_arm import exact_delay, schedules
 from motiongym.baselines.dual_arm.boundary_following import boundary_following
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.envs.core import params_from_kwargs
+from motiongym.envs.dual_arm.params import DualArmParams
 from motiongym.envs.dual_arm.task import DT
 from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
 
@@ -61,9 +63,12 @@ class SchedulePolicy(ScriptedPolicy):
         if action_space.shape not in ((1,), (2,)):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
-        self.safety_margin = float(self.env_kwargs.get("safety_margin", 0.0))
+        params = params_from_kwargs(
+            DualArmParams, self.env_kwargs, ignore=("render_mode", "max_episode_steps")
+        )
+        self.safety_margin = params.safety_margin
         # v1 checks the motion between samples: plan on the swept (conservative) map.
-        self.swept = self.env_kwargs.get("collision_check", "samples") == "swept"
+        self.swept = params.collision_check == "swept"
         self.margin = self.safety_margin + float(plan_margin)
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 

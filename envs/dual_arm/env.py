@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 import gymnasium as gym
@@ -9,15 +10,12 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
-from motiongym.envs.core import check_choice
+from motiongym.envs.core import check_choice, check_options, check_render_mode
 from motiongym.envs.dual_arm import motion
 from motiongym.envs.dual_arm import task as task_module
+from motiongym.envs.dual_arm.params import CONTROLS, WEIGHTS, DualArmParams
 from motiongym.envs.dual_arm.task import DT, TASK_MODES
 from motiongym.envs.dual_arm.world import OBS, DualArmWorld, observation_bounds
-
-CONTROLS = ("both", "robot_2")
-COLLISION_CHECKS = ("samples", "swept")
-OPTIONS = ("task",)
 
 
 class DualArmCellEnv(gym.Env):
@@ -141,25 +139,22 @@ class DualArmCellEnv(gym.Env):
         render_mode: str | None = None,
         collision_check: str = "samples",
     ) -> None:
-        if control not in CONTROLS:
-            raise ValueError(f"unknown control {control!r}; choose one of {', '.join(CONTROLS)}")
-        if task not in TASK_MODES:
-            raise ValueError(f"unknown task {task!r}; choose one of {', '.join(TASK_MODES)}")
-        if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"unknown render_mode {render_mode!r}; choose 'rgb_array' or None")
-        if clearance_distance <= 0:
-            raise ValueError("clearance_distance must be positive (m)")
-        self.collision_check = check_choice("collision_check", collision_check, COLLISION_CHECKS)
-        self.control, self.task = control, task
-        self.safety_margin = float(safety_margin)
-        self.clearance_distance = float(clearance_distance)
-        self.weights = {
-            "time": float(time),
-            "collision": float(collision),
-            "clearance": float(clearance),
-            "advance": float(advance),
-        }
-        self.render_mode = render_mode
+        self.params = p = DualArmParams(
+            control,
+            task,
+            safety_margin,
+            clearance_distance,
+            time,
+            collision,
+            clearance,
+            advance,
+            collision_check,
+        )
+        self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
+        self.control, self.task, self.collision_check = p.control, p.task, p.collision_check
+        self.safety_margin = p.safety_margin
+        self.clearance_distance = p.clearance_distance
+        self.weights = {name: getattr(p, name) for name in WEIGHTS}
         n_act = 2 if control == "both" else 1
         self.action_space = spaces.Box(0.0, 1.0, (n_act,), np.float32)
         lo, hi = observation_bounds()
@@ -173,15 +168,8 @@ class DualArmCellEnv(gym.Env):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
-        options = dict(options or {})
-        unknown = set(options) - set(OPTIONS)
-        if unknown:
-            raise ValueError(
-                f"unknown reset options {sorted(unknown)}; valid: {', '.join(OPTIONS)}"
-            )
+        options = check_options(options, {"task": partial(check_choice, choices=TASK_MODES)})
         mode = options.get("task", self.task)
-        if mode not in TASK_MODES:
-            raise ValueError(f"unknown task {mode!r}; choose one of {', '.join(TASK_MODES)}")
         self.world.load(*task_module.sample_pair(self.np_random, mode, self.safety_margin))
         self._wait2 = 0.0
         info = self._info(collided=False, terms={k: 0.0 for k in self.weights})
@@ -262,4 +250,6 @@ class DualArmCellEnv(gym.Env):
         return info
 
 
-__all__ = ["CONTROLS", "OBS", "DualArmCellEnv"]
+OPTIONS = ("task",)  # reset options
+
+__all__ = ["CONTROLS", "OBS", "OPTIONS", "DualArmCellEnv"]

@@ -77,7 +77,7 @@ def load_map_file(path: str | pathlib.Path, w: int = 1) -> np.ndarray:
     """Load a user map from a ``.txt`` or ``.png`` file and validate it for robot width ``w``."""
     path = pathlib.Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"map file {str(path)!r} does not exist")
+        raise MapError(f"map_file must be an existing .txt or .png file, got {str(path)!r}")
     suffix = path.suffix.lower()
     if suffix == ".png":
         from PIL import Image
