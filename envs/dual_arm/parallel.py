@@ -88,5 +88,10 @@ class DualArmParallelEnv(ParallelEnv):
     def close(self) -> None:
         self._env.close()
 
+    @property
+    def state_space(self) -> spaces.Box:
+        """The global state: the single-agent environment's observation (both arms)."""
+        return self._env.observation_space
+
     def state(self) -> np.ndarray:
         return self._env.world.observation()

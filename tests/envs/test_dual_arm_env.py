@@ -153,3 +153,12 @@ def test_pettingzoo_parallel_env():
         steps += 1
     # robot 2 never moves: robot 1 finishes alone, but robot 2 is not done: truncated
     assert truncs["robot_1"] and steps == 1000
+
+
+def test_pettingzoo_state_test_passes():
+    from pettingzoo.test import state_test
+    from pettingzoo.utils.conversions import parallel_to_aec
+
+    from motiongym.envs.dual_arm import parallel_env
+
+    state_test(parallel_to_aec(parallel_env()), parallel_env())
