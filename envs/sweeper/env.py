@@ -231,7 +231,11 @@ class SweeperEnv(NeedsReset, gym.Env):
         return self.world.observation(), reward, info["is_success"], False, info
 
     def _checked_action(self, action: Any) -> int:
-        if not self.action_space.contains(action):
+        try:
+            allowed = self.action_space.contains(action)
+        except (OverflowError, TypeError, ValueError):  # e.g. an int past int64
+            allowed = False
+        if not allowed:
             raise ArgumentError(
                 f"action must be in {self.action_space} (0 forward, 1 left, 2 right: "
                 f"an int or a NumPy integer scalar), got {action!r}"
