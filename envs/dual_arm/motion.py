@@ -109,6 +109,45 @@ def _lower_bound(d: np.ndarray, move1: np.ndarray, move2: np.ndarray) -> np.ndar
     return (d - move1[..., :, None] / 2 - move2[..., None, :] / 2).min(axis=(-2, -1))
 
 
+Box = tuple[float, float, float, float]  # robot 1's span, robot 2's span (fractional samples)
+
+
+def _halving(
+    samples1: np.ndarray, samples2: np.ndarray, box: Box, margin: float, resolution: float, split
+) -> bool:
+    """Bound, then halve (``split``) every box the bound cannot clear, until decided."""
+    todo = [box]
+    while todo:
+        b = np.array(todo)  # (n, 4)
+        q1 = configs(samples1, b[:, :2].mean(axis=1))
+        q2 = configs(samples2, b[:, 2:].mean(axis=1))
+        d = model.pair_distances(q1, q2)  # (n, 5, 5)
+        if (d.min(axis=(-2, -1)) <= margin).any():
+            return True
+        m1 = body_motion(variation(samples1, b[:, 0], b[:, 1]))
+        m2 = body_motion(variation(samples2, b[:, 2], b[:, 3]))
+        todo = []
+        for i in np.flatnonzero(_lower_bound(d, m1, m2) <= margin):
+            w1, w2 = m1[i].max(), m2[i].max()
+            if (w1 + w2) / 2 < resolution:
+                return True  # within resolution of the margin: conservative
+            todo += split(*b[i], w1, w2)
+    return False
+
+
+def _together(lo1: float, hi1: float, lo2: float, hi2: float, w1: float, w2: float) -> list:
+    c1, c2 = (lo1 + hi1) / 2, (lo2 + hi2) / 2
+    return [(lo1, c1, lo2, c2), (c1, hi1, c2, hi2)]
+
+
+def _longer(lo1: float, hi1: float, lo2: float, hi2: float, w1: float, w2: float) -> list:
+    if w1 >= w2:
+        c = (lo1 + hi1) / 2
+        return [(lo1, c, lo2, hi2), (c, hi1, lo2, hi2)]
+    c = (lo2 + hi2) / 2
+    return [(lo1, hi1, lo2, c), (lo1, hi1, c, hi2)]
+
+
 def simultaneous_collide(
     samples1: np.ndarray,
     span1: tuple[float, float],
@@ -119,32 +158,10 @@ def simultaneous_collide(
 ) -> bool:
     """Do the arms come within ``margin`` while both move at once over one step?
 
-    Robot r moves uniformly over ``span_r`` as ``u`` runs from 0 to 1 (both
-    together, as in one environment step).
+    Robot r moves uniformly over ``span_r`` as time runs through the step (both
+    together, as in one environment step): the two spans are halved together.
     """
-    a1, b1 = span1
-    a2, b2 = span2
-    todo = [(0.0, 1.0)]
-    while todo:
-        u0 = np.array([t[0] for t in todo])
-        u1 = np.array([t[1] for t in todo])
-        mid = (u0 + u1) / 2
-        q1 = configs(samples1, a1 + mid * (b1 - a1))
-        q2 = configs(samples2, a2 + mid * (b2 - a2))
-        d = model.pair_distances(q1, q2)  # (n, 5, 5)
-        if (d.min(axis=(-2, -1)) <= margin).any():
-            return True
-        m1 = body_motion(variation(samples1, a1 + u0 * (b1 - a1), a1 + u1 * (b1 - a1)))
-        m2 = body_motion(variation(samples2, a2 + u0 * (b2 - a2), a2 + u1 * (b2 - a2)))
-        unresolved = _lower_bound(d, m1, m2) <= margin
-        if not unresolved.any():
-            return False
-        todo = []
-        for i in np.flatnonzero(unresolved):
-            if (m1[i].max() + m2[i].max()) / 2 < resolution:
-                return True  # within resolution of the margin: conservative
-            todo += [(u0[i], mid[i]), (mid[i], u1[i])]
-    return False
+    return _halving(samples1, samples2, (*span1, *span2), margin, resolution, _together)
 
 
 def spans_collide(
@@ -156,29 +173,6 @@ def spans_collide(
     resolution: float = RESOLUTION,
 ) -> bool:
     """Does any configuration of robot 1 over ``span1`` come within ``margin`` of any
-    configuration of robot 2 over ``span2`` (each a span of fractional samples)?"""
-    todo = [(span1, span2)]
-    while todo:
-        s1 = np.array([t[0] for t in todo])  # (n, 2)
-        s2 = np.array([t[1] for t in todo])
-        q1 = configs(samples1, s1.mean(axis=1))
-        q2 = configs(samples2, s2.mean(axis=1))
-        d = model.pair_distances(q1, q2)
-        if (d.min(axis=(-2, -1)) <= margin).any():
-            return True
-        m1 = body_motion(variation(samples1, s1[:, 0], s1[:, 1]))
-        m2 = body_motion(variation(samples2, s2[:, 0], s2[:, 1]))
-        unresolved = _lower_bound(d, m1, m2) <= margin
-        todo = []
-        for i in np.flatnonzero(unresolved):
-            w1, w2 = m1[i].max(), m2[i].max()
-            if (w1 + w2) / 2 < resolution:
-                return True
-            (lo1, hi1), (lo2, hi2) = s1[i], s2[i]
-            if w1 >= w2:
-                c = (lo1 + hi1) / 2
-                todo += [((lo1, c), (lo2, hi2)), ((c, hi1), (lo2, hi2))]
-            else:
-                c = (lo2 + hi2) / 2
-                todo += [((lo1, hi1), (lo2, c)), ((lo1, hi1), (c, hi2))]
-    return False
+    configuration of robot 2 over ``span2`` (each a span of fractional samples)?
+    The span whose bodies move farther is halved first."""
+    return _halving(samples1, samples2, (*span1, *span2), margin, resolution, _longer)
