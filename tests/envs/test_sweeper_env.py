@@ -181,7 +181,7 @@ def test_bad_keyword_arguments_name_the_argument(kwargs, match) -> None:
 
 
 def test_map_errors_reach_the_user() -> None:
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(ValueError, match="map_file must be an existing"):
         SweeperEnv(map_file="/nonexistent/map.txt")
 
 

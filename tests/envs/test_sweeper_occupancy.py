@@ -115,7 +115,7 @@ def test_shipped_maps_sizes_and_closed() -> None:
 def test_map_errors(tmp_path) -> None:
     with pytest.raises(maps.MapError, match="unknown map 'kitchen'"):
         maps.shipped_map("kitchen")
-    with pytest.raises(FileNotFoundError, match="does not exist"):
+    with pytest.raises(ValueError, match="map_file must be an existing"):
         maps.load_map_file(tmp_path / "none.txt")
     (tmp_path / "open.txt").write_text("####\n#...\n####\n")
     with pytest.raises(maps.MapError, match="not closed"):
