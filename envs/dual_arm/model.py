@@ -219,6 +219,43 @@ def _quat_z(yaw: float) -> list[float]:
     return [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
 
 
+def _add_arm(world: mujoco.MjsBody, r: int, rgba: list[float]) -> None:
+    """Robot ``r + 1``: its base cylinder and six hinged link capsules (DH chain)."""
+    base = world.add_body(name=f"r{r + 1}_base", pos=[BASE_X[r], 0, 0], quat=_quat_z(BASE_YAW[r]))
+    base.add_geom(
+        name=f"r{r + 1}_base",
+        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+        size=[BASE_RADIUS, BASE_HEIGHT / 2, 0],
+        pos=[0, 0, BASE_HEIGHT / 2],
+        rgba=[0.3, 0.3, 0.3, 1],
+        contype=0,
+        conaffinity=0,
+    )
+    parent, pos, quat = base, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]
+    for k in range(6):
+        body = parent.add_body(name=f"r{r + 1}_{BODY_NAMES[k + 1]}", pos=pos, quat=quat)
+        body.add_joint(
+            name=f"r{r + 1}_q{k + 1}",
+            type=mujoco.mjtJoint.mjJNT_HINGE,
+            axis=[0, 0, 1],
+            range=JOINT_LIMITS[k].tolist(),
+        )
+        start, end, radius = LINKS[k]
+        body.add_geom(
+            name=f"r{r + 1}_{BODY_NAMES[k + 1]}",
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+            fromto=[*start, *end],
+            size=[radius, 0, 0],
+            rgba=rgba,
+            margin=0.0,
+            contype=0,
+            conaffinity=0,
+        )
+        d, a, alpha = DH[k]
+        parent, pos = body, [a, 0.0, d]
+        quat = [math.cos(alpha / 2), math.sin(alpha / 2), 0.0, 0.0]
+
+
 def build_spec(pair_range: float = 10.0) -> mujoco.MjSpec:
     """Both arms as a kinematic MuJoCo model built with ``MjSpec``.
 
@@ -245,41 +282,7 @@ def build_spec(pair_range: float = 10.0) -> mujoco.MjSpec:
     world.add_camera(name="overview", pos=[0.0, -2.3, 1.5], quat=[0.803857, 0.594823, 0.0, 0.0])
     colours = ([0.85, 0.35, 0.2, 1.0], [0.2, 0.45, 0.85, 1.0])
     for r in range(2):
-        base = world.add_body(
-            name=f"r{r + 1}_base", pos=[BASE_X[r], 0, 0], quat=_quat_z(BASE_YAW[r])
-        )
-        base.add_geom(
-            name=f"r{r + 1}_base",
-            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-            size=[BASE_RADIUS, BASE_HEIGHT / 2, 0],
-            pos=[0, 0, BASE_HEIGHT / 2],
-            rgba=[0.3, 0.3, 0.3, 1],
-            contype=0,
-            conaffinity=0,
-        )
-        parent, pos, quat = base, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]
-        for k in range(6):
-            body = parent.add_body(name=f"r{r + 1}_{BODY_NAMES[k + 1]}", pos=pos, quat=quat)
-            body.add_joint(
-                name=f"r{r + 1}_q{k + 1}",
-                type=mujoco.mjtJoint.mjJNT_HINGE,
-                axis=[0, 0, 1],
-                range=JOINT_LIMITS[k].tolist(),
-            )
-            start, end, radius = LINKS[k]
-            body.add_geom(
-                name=f"r{r + 1}_{BODY_NAMES[k + 1]}",
-                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-                fromto=[*start, *end],
-                size=[radius, 0, 0],
-                rgba=colours[r],
-                margin=0.0,
-                contype=0,
-                conaffinity=0,
-            )
-            d, a, alpha = DH[k]
-            parent, pos = body, [a, 0.0, d]
-            quat = [math.cos(alpha / 2), math.sin(alpha / 2), 0.0, 0.0]
+        _add_arm(world, r, colours[r])
     for i in CHECKED:
         for j in CHECKED:
             spec.add_pair(
