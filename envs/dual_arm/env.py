@@ -160,7 +160,6 @@ class DualArmCellEnv(gym.Env):
         lo, hi = observation_bounds()
         self.observation_space = spaces.Box(lo, hi, dtype=np.float32)
         self.world = DualArmWorld()
-        self._last_info: dict[str, Any] = {}
 
     # ------------------------------------------------------------------ API
 

@@ -133,11 +133,6 @@ def body_frames(q: np.ndarray, base: np.ndarray) -> np.ndarray:
     return frames
 
 
-def flange_frame(q: np.ndarray, base: np.ndarray) -> np.ndarray:
-    """``F_6``: the frame at the wrist centre after joint 6 (..., 4, 4)."""
-    return body_frames(q, base)[..., 5, :, :]
-
-
 def wrist_centre(q: np.ndarray, base: np.ndarray) -> np.ndarray:
     """Wrist centre (origin of frames 4-6), shape (..., 3): the paper's wrist point."""
     return body_frames(q, base)[..., 4, :3, 3]
@@ -317,11 +312,6 @@ class MujocoCell:
             ]
             for r in range(2)
         ]
-
-    def set_joints(self, q1: np.ndarray, q2: np.ndarray) -> None:
-        self.data.qpos[:6] = q1
-        self.data.qpos[6:] = q2
-        mujoco.mj_kinematics(self.model, self.data)
 
     def distances(self, q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
         self.data.qpos[:6] = q1
