@@ -202,6 +202,8 @@ def bench(out_dir: Path, quick: bool = False, env_ids: list[str] | None = None) 
             name: policy_ms_per_step(env_id, name, 200 if quick else 2000)
             for name in scripted_policies(env_id)
         }
+        dt = getattr(make_env(env_id).unwrapped, "dt", None)  # s; None: no clock (grid)
+        row["control_period_ms"] = None if dt is None else 1000.0 * dt
         row["ppo_steps_per_s"] = ppo_steps_per_second(env_id, ppo_steps)
         row["x PPO Reacher-v5"] = row["ppo_steps_per_s"] / results["references"]["PPO Reacher-v5"]
         if gym.spec(env_id).vector_entry_point:
@@ -243,6 +245,11 @@ def _vector_row(env_id: str, seconds: float, quick: bool) -> dict[str, Any]:
     return row
 
 
+def _period(ms: float | None) -> str:
+    """The control period as printed (a grid world has none)."""
+    return "-" if ms is None else f"{ms:.0f}"
+
+
 def markdown(results: dict[str, Any]) -> str:
     """The environment table as Markdown (for the README)."""
     refs = results["references"]
@@ -282,10 +289,11 @@ def markdown(results: dict[str, Any]) -> str:
             goal = f"<= {planner['goal_s']} s {planner['goal_met']}" if planner["goal_s"] else ""
             lines.append(f"| {label} | {planner['seconds']:.4f} | {goal} |")
     policy_rows = [
-        f"| {row['id']} | {name} | {ms:.3f} |"
+        f"| {row['id']} | {name} | {ms:.3f} | {_period(row.get('control_period_ms'))} |"
         for row in results["environments"]
         for name, ms in row["policy_ms_per_step"].items()
     ]
     if policy_rows:
-        lines += ["", "| ID | scripted policy | ms per step |", "|---|---|---:|", *policy_rows]
+        header = "| ID | scripted policy | ms per step | control period (ms) |"
+        lines += ["", header, "|---|---|---:|---:|", *policy_rows]
     return "\n".join(lines) + "\n"
