@@ -124,6 +124,14 @@ class DualArmCellEnv(gym.Env):
             "makespan": "last",
             "robot_2_wait": "last",
         },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "collision": "rate",
+            "distance": "m",
+            "makespan": "s",
+            "robot_2_wait": "s",
+        },
     }
 
     def __init__(

@@ -243,6 +243,15 @@ class ExcavatorReachEnv(ExcavatorBase):
             "truck_clearance": "min",
             "elapsed": "last",
         },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "position_error": "m",
+            "angle_error": "rad",
+            "pipe_clearance": "m",
+            "truck_clearance": "m",
+            "elapsed": "s",
+        },
     }
 
 
@@ -312,6 +321,18 @@ class ExcavatorEnv(ExcavatorBase):
             "pipe_clearance": "min",
             "truck_clearance": "min",
             "elapsed": "last",
+        },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "dig_fill": "m3",
+            "outside_zone": "m3",
+            "truck_soil": "m3",
+            "spill": "m3",
+            "pipe_contact": "rate",
+            "pipe_clearance": "m",
+            "truck_clearance": "m",
+            "elapsed": "s",
         },
     }
 

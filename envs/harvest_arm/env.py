@@ -129,6 +129,14 @@ class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
             "min_distance": "min",
             "distance_to_fruit": "last",
         },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "collision": "rate",
+            "close_approach": "rate",
+            "min_distance": "m",
+            "distance_to_fruit": "m",
+        },
     }
 
     def __init__(

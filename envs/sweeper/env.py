@@ -173,6 +173,17 @@ class SweeperEnv(NeedsReset, gym.Env):
             "cost": "sum",
             "is_success": "last",
         },
+        "info_units": {
+            "coverage": "fraction",
+            "travel": "cells",
+            "travel_ratio": "ratio",
+            "overlap": "fraction",
+            "turns": "count",
+            "bumps": "count",
+            "steps": "steps",
+            "cost": "steps",
+            "is_success": "rate",
+        },
     }
 
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:

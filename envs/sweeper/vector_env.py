@@ -95,6 +95,7 @@ class SweeperVectorEnv(VectorEnv):
         "render_fps": 30,
         "autoreset_mode": AutoresetMode.SAME_STEP,
         "info_measures": dict(SweeperEnv.metadata["info_measures"]),
+        "info_units": dict(SweeperEnv.metadata["info_units"]),
     }
     recycle_observations = True  # False: fresh observation arrays on every call (slower)
 
