@@ -1,4 +1,5 @@
-"""The ``motiongym`` command: list, evaluate, compare, train, ship, benchmarks, reproduce, bench.
+"""The ``motiongym`` command: list, evaluate, compare, train, ship, record, benchmarks,
+reproduce, bench.
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
 malformed YAML file, a model built for another space) ends in one line on
@@ -172,6 +173,34 @@ def cmd_ship(args: argparse.Namespace) -> None:
         console.print(f"replaced a model with {describe(shipped.previous)} on the same episodes")
 
 
+def cmd_record(args: argparse.Namespace) -> None:
+    from motiongym.agents.record import record
+    from motiongym.agents.report import console
+    from motiongym.baselines import scripted_policies
+
+    check_env_id(args.env_id)
+    policy = args.policy or next(iter(scripted_policies(args.env_id)), "random")
+    recording = record(
+        args.env_id,
+        policy,
+        args.seed,
+        args.out,
+        _env_kwargs(args.env_kwargs),
+        every=args.every,
+        trust=args.trust,
+    )
+    episode = recording.episode
+    console.print(
+        f"{policy} on {args.env_id}, seed {args.seed}: {episode['length']} steps, "
+        f"return {episode['return']:.4g}, {recording.frames} frames at {recording.fps:g} fps"
+    )
+    for path in (recording.mp4, recording.gif):
+        if path is not None:
+            console.print(f"wrote {path}")
+    for note in recording.notes:
+        print(f"motiongym: {note}", file=sys.stderr)
+
+
 def cmd_benchmarks(args: argparse.Namespace) -> None:
     from motiongym.agents.benchmarks import write_benchmarks
     from motiongym.agents.report import console
@@ -305,6 +334,38 @@ def build_parser() -> argparse.ArgumentParser:
         help="replace a shipped model that scores better (default: refuse, printing both scores)",
     )
     ship.set_defaults(handler=cmd_ship)
+
+    recorder = commands.add_parser("record", help="one episode as an MP4 and a GIF")
+    recorder.add_argument("env_id", help="environment ID, e.g. motiongym/Sweeper-v0")
+    recorder.add_argument(
+        "--policy",
+        help="a policy name, model .zip or run folder (default: the paper's scripted policy)",
+    )
+    recorder.add_argument(
+        "--seed", type=_seed, default=0, help="the episode's reset seed (default 0)"
+    )
+    recorder.add_argument(
+        "--every", type=_count, default=1, help="keep one frame in N steps (default 1: every step)"
+    )
+    recorder.add_argument(
+        "--env-kwargs",
+        nargs="*",
+        default=[],
+        metavar="KEY=VALUE",
+        help="keywords for gym.make, values read as YAML (default: none, the registered task)",
+    )
+    recorder.add_argument(
+        "--out",
+        type=_folder,
+        default=Path("results/record"),
+        help="folder (default results/record)",
+    )
+    recorder.add_argument(
+        "--trust",
+        action="store_true",
+        help="load a model folder without manifest.json (default: refuse such a folder)",
+    )
+    recorder.set_defaults(handler=cmd_record)
 
     benchmarks = commands.add_parser(
         "benchmarks", help="regenerate BENCHMARKS.md: scripted vs learned on every ID"
