@@ -220,6 +220,26 @@ def cmd_bench(args: argparse.Namespace) -> None:
     bench(args.out, quick=args.quick, env_ids=args.ids or None)
 
 
+def _env_kwargs_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--env-kwargs",
+        nargs="*",
+        default=[],
+        metavar="KEY=VALUE",
+        help="keywords for gym.make (the environment's own, or max_episode_steps); "
+        "values read as YAML (default: none, the registered task)",
+    )
+
+
+def _trust_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--trust",
+        action="store_true",
+        help="load a model folder without manifest.json (nothing in it is unpickled either way; "
+        "default: refuse such a folder)",
+    )
+
+
 def _evaluation_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--episodes",
@@ -233,26 +253,14 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
         default=EVALUATION_SEED,
         help=f"seed of the first episode; episode i uses seed+i (default {EVALUATION_SEED})",
     )
-    parser.add_argument(
-        "--env-kwargs",
-        nargs="*",
-        default=[],
-        metavar="KEY=VALUE",
-        help="keywords for gym.make (the environment's own, or max_episode_steps); "
-        "values read as YAML (default: none, the registered task)",
-    )
+    _env_kwargs_option(parser)
     parser.add_argument(
         "--out", type=_folder, default=Path("results"), help="output folder (default results)"
     )
     parser.add_argument(
         "--no-progress", action="store_true", help="no progress bar (default: a progress bar)"
     )
-    parser.add_argument(
-        "--trust",
-        action="store_true",
-        help="load a model folder without manifest.json (nothing in it is unpickled either way; "
-        "default: refuse such a folder)",
-    )
+    _trust_option(parser)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -347,24 +355,14 @@ def build_parser() -> argparse.ArgumentParser:
     recorder.add_argument(
         "--every", type=_count, default=1, help="keep one frame in N steps (default 1: every step)"
     )
-    recorder.add_argument(
-        "--env-kwargs",
-        nargs="*",
-        default=[],
-        metavar="KEY=VALUE",
-        help="keywords for gym.make, values read as YAML (default: none, the registered task)",
-    )
+    _env_kwargs_option(recorder)
     recorder.add_argument(
         "--out",
         type=_folder,
         default=Path("results/record"),
         help="folder (default results/record)",
     )
-    recorder.add_argument(
-        "--trust",
-        action="store_true",
-        help="load a model folder without manifest.json (default: refuse such a folder)",
-    )
+    _trust_option(recorder)
     recorder.set_defaults(handler=cmd_record)
 
     benchmarks = commands.add_parser(
