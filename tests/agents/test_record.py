@@ -50,3 +50,16 @@ def test_record_without_ffmpeg_still_writes_the_gif_and_says_how(tmp_path, capsy
     captured = capsys.readouterr()
     assert 'pip install "motiongym[video]"' in captured.err
     assert [p.suffix for p in tmp_path.iterdir()] == [".gif"]
+
+
+def test_the_readmes_gifs_exist_and_are_small():
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).parents[2]
+    gifs = re.findall(r"\((docs/media/[^)]+\.gif)\)", (root / "README.md").read_text())
+    assert len(gifs) == 4  # one per world
+    for gif in gifs:
+        assert (root / gif).stat().st_size < 2_000_000, gif
+        with Image.open(root / gif) as image:
+            assert image.n_frames > 10 and image.size[0] == 320
