@@ -108,6 +108,7 @@ class DualArmCellEnv(Renders, gym.Env):
     1 mm of resolution, never missed).
 
     ## Version history
+
     * v1: ``collision_check="swept"``: collisions between control samples
       count (an undelayed pair that grazed between two 20 ms samples passed
       v0's check).

@@ -277,7 +277,7 @@ class ExcavatorEnv(ExcavatorBase):
     completed cycle); ``spill`` = -spill * soil spilled (m3);
     ``clearance`` = -clearance on a step with cost; ``contact`` = -contact
     on contact; ``time`` = -time per step; ``success`` = +success on success;
-    ``approach`` = approach * (|tip_prev - g| - |tip - g|), the step's
+    ``approach`` = ``approach * (|tip_prev - g| - |tip - g|)``, the step's
     progress (m) toward the subgoal g of :meth:`DigTask.subgoal`, 0 in the
     registered ID: a dense shaping for training (configs) that draws the
     bucket into the middle of the zone at the marked depth while it holds

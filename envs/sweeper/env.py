@@ -44,6 +44,7 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
     see-through variant: every obstacle in the window is sensed.
 
     ## Action space: ``Discrete(3)``
+
     ===== ==========================================================
     0     move forward one cell (a move into an obstacle is a bump:
           the robot stays and senses it)
@@ -154,6 +155,7 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
     ``reset()`` raise RuntimeError.
 
     ## Version history
+
     - v1: line-of-sight sensing (an obstacle hides what lies behind it) and
       the ``known`` observation key telling unknown from free.
     - v0: first version; the window sees through walls (kept as the
