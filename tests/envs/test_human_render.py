@@ -19,8 +19,9 @@ from motiongym.envs import ENV_IDS
 from motiongym.envs.dual_arm import parallel_env
 from motiongym.envs.sweeper.vector_env import SweeperVectorEnv
 
-NEWEST = {"motiongym/Sweeper-v0", *(i for i in ENV_IDS if i.endswith("-v1"))}
-IDS = [i if i in NEWEST else pytest.param(i, marks=pytest.mark.slow) for i in ENV_IDS]
+# one ID per world in the default suite, the others with the slow tests
+ONE_PER_WORLD = {f"motiongym/{n}-v1" for n in ("Sweeper", "HarvestArm", "DualArmCell", "Excavator")}
+IDS = [i if i in ONE_PER_WORLD else pytest.param(i, marks=pytest.mark.slow) for i in ENV_IDS]
 
 
 @pytest.fixture
