@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 EPISODES ?= 10
 
-.PHONY: install demo test test-slow lint models benchmarks fuzz
+.PHONY: install demo test test-slow lint models benchmarks fuzz docs
 
 $(STAMP): pyproject.toml setup.py
 	python3 -m venv $(VENV)
@@ -31,6 +31,13 @@ test-slow: $(STAMP)
 # the default suite runs a fast slice); prints the counts per outcome.
 fuzz: $(STAMP)
 	MUJOCO_GL=egl MOTIONGYM_FUZZ=fuzz $(BIN)/pytest -q -s tests/fuzz
+
+# The documentation site (Sphinx, furo): a page per ID from its docstring, the papers,
+# the API reference; warnings are errors. Installs the optional extra `docs` first.
+docs: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	MUJOCO_GL=egl $(BIN)/sphinx-build -W --keep-going -q -b html docs/site docs/site/_build/html
+	@echo "docs/site/_build/html/index.html"
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

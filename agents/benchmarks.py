@@ -19,6 +19,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from matplotlib.figure import Figure
+from matplotlib.ticker import EngFormatter
 
 from motiongym.agents.environments import make_env, short_name
 from motiongym.agents.evaluate import EVALUATION_SEED, Evaluation, evaluate
@@ -46,30 +47,57 @@ def pooled_evaluation(folder: Path) -> tuple[Evaluation, dict]:
     return Evaluation(metrics["env_id"], label, episodes), metrics
 
 
-def learning_curve_figure(curves: dict[str, Path], path: Path, env_id: str) -> Path:
-    """Evaluation return and success rate against steps, one line per training seed."""
-    figure = Figure(figsize=(9, 3.2))
+SEED_STYLES = ("-", "--", ":", "-.")  # one line style per training seed
+
+
+def _read_curves(file: Path) -> dict[str, list[tuple[float, float, float]]]:
+    """``{training seed: [(steps, mean return, success rate), ...]}`` of a curves file."""
+    by_seed: dict[str, list[tuple[float, float, float]]] = defaultdict(list)
+    with file.open() as handle:
+        for row in csv.DictReader(handle):
+            by_seed[row["training_seed"]].append(
+                (float(row["timesteps"]), float(row["mean_return"]), float(row["success_rate"]))
+            )
+    return dict(sorted(by_seed.items()))
+
+
+def learning_curve_figure(
+    curves: dict[str, Path],
+    path: Path,
+    env_id: str,
+    reference: tuple[str, float] | None = None,
+) -> Path:
+    """Evaluation return and success rate against training steps: a colour per
+    shipped agent, a line style per training seed, and ``reference`` (a scripted
+    policy's name and its success rate on the held-out episodes) as a dashed
+    horizontal line on the success panel. The return panel has no reference:
+    the callback's return is the training reward, shaping included."""
+    figure = Figure(figsize=(10, 3.6))
     ax_return, ax_success = figure.subplots(1, 2)
     for n, (label, file) in enumerate(curves.items()):
-        by_seed: dict[str, list[tuple[float, float, float]]] = defaultdict(list)
-        with file.open() as handle:
-            for row in csv.DictReader(handle):
-                by_seed[row["training_seed"]].append(
-                    (float(row["timesteps"]), float(row["mean_return"]), float(row["success_rate"]))
-                )
-        for k, (seed, points) in enumerate(sorted(by_seed.items())):
+        for k, (seed, points) in enumerate(_read_curves(file).items()):
             steps, returns, successes = zip(*points, strict=True)
-            name = f"{label} seed {seed}"
-            style = dict(color=f"C{n}", alpha=1.0 - 0.25 * k, label=name)
-            ax_return.plot(steps, returns, **style)
+            style = dict(color=f"C{n}", ls=SEED_STYLES[k % len(SEED_STYLES)], lw=1.4)
+            ax_return.plot(steps, returns, label=f"{label} seed {seed}", **style)
             ax_success.plot(steps, successes, **style)
+    if reference is not None:
+        name, rate = reference
+        ax_success.axhline(rate, color="k", ls="--", lw=1, label=f"{name} (scripted)")
+    shared = any(label.endswith("-shared") for label in curves)
+    for ax in (ax_return, ax_success):
+        ax.set_xlabel("training steps" + (" (agent steps for -shared)" if shared else ""))
+        ax.xaxis.set_major_formatter(EngFormatter(sep=""))
+        ax.grid(alpha=0.3)
     ax_return.set_ylabel("evaluation return (training reward)")
     ax_success.set_ylabel("evaluation success rate")
+    ax_success.set_ylim(-0.02, 1.02)
+    handles, labels = [], []
     for ax in (ax_return, ax_success):
-        ax.set_xlabel("training steps (agent steps for -shared)")
-    ax_success.legend(fontsize=7)
+        h, lab = ax.get_legend_handles_labels()
+        handles, labels = handles + h, labels + lab
+    figure.legend(handles, labels, loc="center right", fontsize=7, frameon=False)
     figure.suptitle(f"{env_id}: learning curves (evaluation callback)", fontsize=10)
-    figure.tight_layout()
+    figure.tight_layout(rect=(0, 0, 0.8, 1))
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=100)
     return path
@@ -90,13 +118,20 @@ def benchmark_section(env_id: str, n_episodes: int, figures: Path, root: Path) -
     ]
     env.close()
     lines = [f"### {env_id}", "", comparison_markdown(scripted + learned)]
+    paper = next(iter(scripted_policies(env_id)), None)  # declared first: the paper's
+    reference = None
+    for evaluation in scripted:
+        if evaluation.policy == paper and "is_success" in evaluation.summary():
+            reference = (paper, evaluation.summary()["is_success"]["mean"])
     curves = {
         label: folder / LEARNING_CURVES
         for label, folder in shipped.items()
         if len((folder / LEARNING_CURVES).read_text().splitlines()) > 1  # a header, rows
     }
     if curves:
-        figure = learning_curve_figure(curves, figures / f"{short_name(env_id)}.png", env_id)
+        figure = learning_curve_figure(
+            curves, figures / f"{short_name(env_id)}.png", env_id, reference
+        )
         lines += [f"![learning curves of {env_id}]({figure.relative_to(root).as_posix()})", ""]
     return "\n".join(lines)
 

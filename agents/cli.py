@@ -1,4 +1,5 @@
-"""The ``motiongym`` command: list, evaluate, compare, train, ship, benchmarks, reproduce, bench.
+"""The ``motiongym`` command: list, evaluate, compare, train, ship, record, benchmarks,
+reproduce, bench.
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
 malformed YAML file, a model built for another space) ends in one line on
@@ -31,6 +32,16 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
         print(f"motiongym: error: {message}", file=sys.stderr)
         raise SystemExit(2)
+
+
+def package_version() -> str:
+    """The installed distribution's version (pyproject.toml's)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("motiongym")
+    except PackageNotFoundError:  # run from a source tree that was never installed
+        return "unknown (not installed)"
 
 
 def _count(text: str) -> int:
@@ -107,13 +118,12 @@ def cmd_list(args: argparse.Namespace) -> None:
 
 
 def cmd_evaluate(args: argparse.Namespace) -> None:
-    from motiongym.agents.report import console, summary_table
+    from motiongym.agents.report import console, summary_table, write_evaluation
 
     check_env_id(args.env_id)
     (evaluation,) = _evaluations(args.env_id, [args.policy], args)
     console.print(summary_table(evaluation))
-    stem = f"{short_name(args.env_id)}_{evaluation.policy}"
-    for path in evaluation.write(args.out, stem):
+    for path in write_evaluation(evaluation, args.out, short_name(args.env_id)):
         console.print(f"wrote {path}")
 
 
@@ -153,9 +163,42 @@ def cmd_train(args: argparse.Namespace) -> None:
 
 def cmd_ship(args: argparse.Namespace) -> None:
     from motiongym.agents.report import console
-    from motiongym.agents.ship import ship
+    from motiongym.agents.ship import describe, ship
 
-    console.print(f"shipped to {ship(args.run_dirs, n_episodes=args.episodes)}")
+    shipped = ship(args.run_dirs, n_episodes=args.episodes, root=args.into, force=args.force)
+    console.print(
+        f"shipped to {shipped.folder}: {describe(shipped.score)} on the held-out episodes"
+    )
+    if shipped.previous is not None:
+        console.print(f"replaced a model with {describe(shipped.previous)} on the same episodes")
+
+
+def cmd_record(args: argparse.Namespace) -> None:
+    from motiongym.agents.record import record
+    from motiongym.agents.report import console
+    from motiongym.baselines import scripted_policies
+
+    check_env_id(args.env_id)
+    policy = args.policy or next(iter(scripted_policies(args.env_id)), "random")
+    recording = record(
+        args.env_id,
+        policy,
+        args.seed,
+        args.out,
+        _env_kwargs(args.env_kwargs),
+        every=args.every,
+        trust=args.trust,
+    )
+    episode = recording.episode
+    console.print(
+        f"{policy} on {args.env_id}, seed {args.seed}: {episode['length']} steps, "
+        f"return {episode['return']:.4g}, {recording.frames} frames at {recording.fps:g} fps"
+    )
+    for path in (recording.mp4, recording.gif):
+        if path is not None:
+            console.print(f"wrote {path}")
+    for note in recording.notes:
+        print(f"motiongym: {note}", file=sys.stderr)
 
 
 def cmd_benchmarks(args: argparse.Namespace) -> None:
@@ -177,6 +220,26 @@ def cmd_bench(args: argparse.Namespace) -> None:
     bench(args.out, quick=args.quick, env_ids=args.ids or None)
 
 
+def _env_kwargs_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--env-kwargs",
+        nargs="*",
+        default=[],
+        metavar="KEY=VALUE",
+        help="keywords for gym.make (the environment's own, or max_episode_steps); "
+        "values read as YAML (default: none, the registered task)",
+    )
+
+
+def _trust_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--trust",
+        action="store_true",
+        help="load a model folder without manifest.json (nothing in it is unpickled either way; "
+        "default: refuse such a folder)",
+    )
+
+
 def _evaluation_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--episodes",
@@ -190,23 +253,14 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
         default=EVALUATION_SEED,
         help=f"seed of the first episode; episode i uses seed+i (default {EVALUATION_SEED})",
     )
-    parser.add_argument(
-        "--env-kwargs",
-        nargs="*",
-        default=[],
-        metavar="KEY=VALUE",
-        help="keywords for gym.make (the environment's own, or max_episode_steps); "
-        "values read as YAML",
-    )
+    _env_kwargs_option(parser)
     parser.add_argument(
         "--out", type=_folder, default=Path("results"), help="output folder (default results)"
     )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
-        "--trust",
-        action="store_true",
-        help="load a model folder without manifest.json (nothing in it is unpickled either way)",
+        "--no-progress", action="store_true", help="no progress bar (default: a progress bar)"
     )
+    _trust_option(parser)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -216,6 +270,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="motiongym", description="Scripted and learned control of classic robot motion tasks."
     )
+    parser.add_argument("--version", action="version", version=f"motiongym {package_version()}")
     commands = parser.add_subparsers(dest="command", required=True)
 
     listing = commands.add_parser("list", help="environment IDs and their policies")
@@ -233,11 +288,13 @@ def build_parser() -> argparse.ArgumentParser:
 
     compare = commands.add_parser("compare", help="run several policies on the same seeds")
     compare.add_argument("env_id", nargs="?", help="environment ID (or --all)")
-    compare.add_argument("--all", action="store_true", help="every registered ID")
+    compare.add_argument(
+        "--all", action="store_true", help="every registered ID (default: the one ID given)"
+    )
     compare.add_argument(
         "--policies",
         nargs="+",
-        help="names or model paths (default: every scripted and shipped policy)",
+        help="names or model paths (default: every scripted and shipped policy, and random)",
     )
     _evaluation_options(compare)
     compare.set_defaults(handler=cmd_compare)
@@ -251,11 +308,18 @@ def build_parser() -> argparse.ArgumentParser:
     )
     train.add_argument("--config", type=Path, help="YAML file (default: configs/<Name>-vN.yml)")
     train.add_argument("--seed", type=_seed, default=0, help="training seed (default 0)")
-    train.add_argument("--timesteps", type=_count, help="override the config's n_timesteps")
+    train.add_argument(
+        "--timesteps",
+        type=_count,
+        help="override the config's n_timesteps (default: the config's; try 5000 for a "
+        "first look, the tuned budgets take hours)",
+    )
     train.add_argument(
         "--out", type=_folder, default=Path("runs"), help="where run folders go (default runs)"
     )
-    train.add_argument("--no-progress", action="store_true", help="no progress bar")
+    train.add_argument(
+        "--no-progress", action="store_true", help="no progress bar (default: a progress bar)"
+    )
     train.set_defaults(handler=cmd_train)
 
     ship = commands.add_parser(
@@ -267,7 +331,39 @@ def build_parser() -> argparse.ArgumentParser:
     ship.add_argument(
         "--episodes", type=_count, default=20, help="held-out evaluation episodes (default 20)"
     )
+    ship.add_argument(
+        "--into",
+        type=_folder,
+        help="folder that holds <ID>/<label>/ (default: the package's agents/pretrained)",
+    )
+    ship.add_argument(
+        "--force",
+        action="store_true",
+        help="replace a shipped model that scores better (default: refuse, printing both scores)",
+    )
     ship.set_defaults(handler=cmd_ship)
+
+    recorder = commands.add_parser("record", help="one episode as an MP4 and a GIF")
+    recorder.add_argument("env_id", help="environment ID, e.g. motiongym/Sweeper-v0")
+    recorder.add_argument(
+        "--policy",
+        help="a policy name, model .zip or run folder (default: the paper's scripted policy)",
+    )
+    recorder.add_argument(
+        "--seed", type=_seed, default=0, help="the episode's reset seed (default 0)"
+    )
+    recorder.add_argument(
+        "--every", type=_count, default=1, help="keep one frame in N steps (default 1: every step)"
+    )
+    _env_kwargs_option(recorder)
+    recorder.add_argument(
+        "--out",
+        type=_folder,
+        default=Path("results/record"),
+        help="folder (default results/record)",
+    )
+    _trust_option(recorder)
+    recorder.set_defaults(handler=cmd_record)
 
     benchmarks = commands.add_parser(
         "benchmarks", help="regenerate BENCHMARKS.md: scripted vs learned on every ID"
@@ -275,19 +371,32 @@ def build_parser() -> argparse.ArgumentParser:
     benchmarks.add_argument(
         "--episodes", type=_count, default=20, help="held-out episodes (default 20)"
     )
-    benchmarks.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
+    benchmarks.add_argument(
+        "--out", type=Path, default=Path("BENCHMARKS.md"), help="file (default BENCHMARKS.md)"
+    )
     benchmarks.set_defaults(handler=cmd_benchmarks)
 
     reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")
     reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))
-    reproduce.add_argument("--quick", action="store_true", help="reduced protocol")
-    reproduce.add_argument("--out", type=_folder, default=Path("results/reproduce"))
+    reproduce.add_argument(
+        "--quick", action="store_true", help="reduced protocol (default: the full one)"
+    )
+    reproduce.add_argument(
+        "--out",
+        type=_folder,
+        default=Path("results/reproduce"),
+        help="output folder; the experiment's own subfolder is made (default results/reproduce)",
+    )
     reproduce.set_defaults(handler=cmd_reproduce)
 
     bench = commands.add_parser("bench", help="throughput against references in the same run")
     bench.add_argument("ids", nargs="*", help="environment IDs (default: all)")
-    bench.add_argument("--quick", action="store_true", help="shorter timings")
-    bench.add_argument("--out", type=_folder, default=Path("results/bench"))
+    bench.add_argument(
+        "--quick", action="store_true", help="shorter timings (default: the full timings)"
+    )
+    bench.add_argument(
+        "--out", type=_folder, default=Path("results/bench"), help="folder (default results/bench)"
+    )
     bench.set_defaults(handler=cmd_bench)
     return parser
 

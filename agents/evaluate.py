@@ -11,7 +11,9 @@ What is measured: the episode's return and length, and every key of the
 environment's ``metadata["info_measures"]`` (``{key: how}``, how being
 ``last``, ``sum``, ``mean``, ``min`` or ``max`` over the episode's steps; the
 reset's ``info`` is not a step and is not counted). An environment that
-declares none reports its return and length only.
+declares none reports its return and length only. Its
+``metadata["info_units"]`` (``{key: unit}``) labels the figures; a unit of
+``rate`` or ``fraction`` marks a measure that lies in [0, 1].
 """
 
 from __future__ import annotations
@@ -52,6 +54,20 @@ def info_measures(env: gym.Env) -> dict[str, str]:
                 f"info measure {key!r} aggregates by {how!r}; valid: {', '.join(AGGREGATIONS)}"
             )
     return measures
+
+
+# Units of the two measures every evaluation has.
+BASE_UNITS = {"return": "reward", "length": "steps"}
+# Units of measures bounded by [0, 1] (their intervals are clipped there in figures).
+RATE_UNITS = ("rate", "fraction")
+# Units of measures that are never negative (their intervals are clipped at 0).
+COUNT_UNITS = ("steps", "count", "cells", "s", "m3", "ratio")
+
+
+def info_units(env: gym.Env) -> dict[str, str]:
+    """``{measure: unit}`` for the return, the length and the environment's declared
+    ``metadata["info_units"]`` (a measure without a unit is left out)."""
+    return {**BASE_UNITS, **env.unwrapped.metadata.get("info_units", {})}
 
 
 @dataclass
@@ -135,6 +151,7 @@ class Evaluation:
     env_id: str
     policy: str
     episodes: list[dict[str, float]] = field(default_factory=list)
+    units: dict[str, str] = field(default_factory=lambda: dict(BASE_UNITS))
 
     @property
     def measures(self) -> list[str]:
@@ -166,6 +183,7 @@ class Evaluation:
             "policy": self.policy,
             "seeds": [episode["seed"] for episode in self.episodes],
             "summary": self.summary(),
+            "units": self.units,
             "episodes": self.episodes,
         }
 
@@ -193,7 +211,7 @@ def evaluate(
     seeds = list(seeds)
     if not seeds:
         raise UsageError("at least one episode is needed")
-    evaluation = Evaluation(env_id, policy)
+    evaluation = Evaluation(env_id, policy, units=info_units(env))
     for seed in tqdm(seeds, desc=f"{policy} on {env_id}", disable=not progress, leave=False):
         evaluation.episodes.append(run_episode(env, predictor, seed))
     return evaluation

@@ -5,6 +5,9 @@ episode_start, deterministic)``: a scripted policy from
 :mod:`motiongym.baselines`, or a trained SB3 model. A policy is named by
 
 * a scripted policy's name declared for the environment ID (``psa-cwa``);
+* ``random``, for every ID: uniform actions, within the action masks where the
+  environment gives them (:class:`RandomPolicy`), the floor every policy
+  should beat;
 * a trained model: a ``.zip`` written by SB3, or a run folder written by
   ``motiongym train`` (holding ``model.zip`` and, if the run normalised
   observations, ``vecnormalize.npz``, which is applied here). Nothing in a
@@ -22,10 +25,13 @@ The algorithm of a bare ``.zip`` is read from the policy class saved in it
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
+import torch
 import yaml
 from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
@@ -51,6 +57,31 @@ from motiongym.baselines import make_policy, scripted_policies
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yml"
+RANDOM = "random"
+
+
+class RandomPolicy:
+    """Uniform random actions: the reference row of ``compare`` for every ID.
+
+    At each episode start the action space's generator is seeded from torch's
+    generator, which :func:`~motiongym.agents.evaluate.run_episode` seeds from
+    the episode's seed: the same episode draws the same actions in every
+    evaluation. Where the environment gives action masks (the sweeper), the
+    action is drawn among the allowed ones, as a masked agent's would be.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        self.env = env
+        self.space = copy.deepcopy(env.action_space)
+        self.masked = hasattr(env.unwrapped, "action_masks")
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        if episode_start is None or bool(np.all(episode_start)):
+            self.space.seed(int(torch.randint(0, 2**31 - 1, (1,)).item()))
+        if self.masked:
+            mask = np.asarray(self.env.unwrapped.action_masks(), dtype=np.int8)
+            return self.space.sample(mask=mask), state
+        return self.space.sample(), state
 
 
 class NormalizedModel:
@@ -189,8 +220,9 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
 
 
 def available_policies(env_id: str) -> list[str]:
-    """The names ``load_predictor`` accepts for ``env_id`` besides paths."""
-    return sorted(scripted_policies(env_id)) + sorted(pretrained_models(env_id))
+    """The names ``load_predictor`` accepts for ``env_id`` besides paths: the scripted
+    policies, the shipped models, and ``random``."""
+    return sorted(scripted_policies(env_id)) + sorted(pretrained_models(env_id)) + [RANDOM]
 
 
 def load_predictor(
@@ -205,6 +237,8 @@ def load_predictor(
     if policy in scripted_policies(env_id):
         kwargs = resolved_env_kwargs(env_id, env_kwargs)
         return make_policy(env_id, policy, env.observation_space, env.action_space, kwargs)
+    if policy == RANDOM:
+        return RandomPolicy(env)
     shipped = pretrained_models(env_id)
     if policy in shipped:
         return load_model(shipped[policy], env, env_id)

@@ -1,39 +1,76 @@
-"""Tables and figures of evaluations: one policy, or several side by side."""
+"""Tables and figures of evaluations: one policy, or several side by side.
+
+Tables never cut a cell: piped or written to a file (no terminal to measure)
+the console is :data:`PIPED_WIDTH` columns wide unless ``COLUMNS`` says
+otherwise, and a cell wider than its column folds onto the next line.
+Figures label every panel with its measure and unit, clip the 95 % interval
+of a rate or fraction to [0, 1], and leave out a measure that is 0 on every
+episode of every policy or that repeats an earlier measure's values.
+"""
 
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
+from typing import IO
 
+import numpy as np
 from matplotlib.figure import Figure
 from rich.console import Console
 from rich.table import Table
 
-from motiongym.agents.evaluate import Evaluation
+from motiongym.agents.evaluate import COUNT_UNITS, RATE_UNITS, Evaluation
 
-console = Console()
+PIPED_WIDTH = 200  # columns of a table written to a pipe or a file
+
+
+def make_console(file: IO[str] | None = None) -> Console:
+    """A console on ``file`` (default standard output) that measures a terminal, and
+    is :data:`PIPED_WIDTH` wide elsewhere."""
+    probe = Console(file=file)
+    if probe.is_terminal or "COLUMNS" in os.environ:
+        return probe
+    return Console(file=file, width=PIPED_WIDTH)
+
+
+console = make_console()
 
 
 def _number(value: float) -> str:
     return f"{value:.4g}"
 
 
+def _unit(evaluation: Evaluation, key: str) -> str:
+    unit = evaluation.units.get(key, "")
+    return f"{key} ({unit})" if unit else key
+
+
 def summary_table(evaluation: Evaluation) -> Table:
-    """Mean, std, min and max of each measure over one policy's episodes."""
+    """Mean, its 95 % interval half-width, std, min and max of each measure over one
+    policy's episodes."""
     n = len(evaluation.episodes)
     table = Table(title=f"{evaluation.policy} on {evaluation.env_id} ({n} episodes)")
-    for column in ("measure", "mean", "std", "min", "max"):
-        table.add_column(column, justify="left" if column == "measure" else "right")
+    for column in ("measure (unit)", "mean", "± 95%", "std", "min", "max"):
+        table.add_column(column, justify="left" if column.startswith("measure") else "right")
     for key, stats in evaluation.summary().items():
-        table.add_row(key, *(_number(stats[s]) for s in ("mean", "std", "min", "max")))
+        values = (stats[s] for s in ("mean", "ci95", "std", "min", "max"))
+        table.add_row(_unit(evaluation, key), *(_number(v) for v in values))
+    _fold(table)
     return table
+
+
+def _fold(table: Table) -> None:
+    """Fold over-wide cells onto the next line instead of cutting them with an ellipsis."""
+    for column in table.columns:
+        column.overflow = "fold"
 
 
 def comparison_rows(evaluations: list[Evaluation]) -> list[list[str]]:
     """One row per measure: its name, then "mean ± 95 % half-width" per policy."""
     summaries = [evaluation.summary() for evaluation in evaluations]
     return [
-        [key]
+        [_unit(evaluations[0], key)]
         + [
             f"{_number(s[key]['mean'])} ± {_number(s[key]['ci95'])}" if key in s else "-"
             for s in summaries
@@ -56,6 +93,7 @@ def comparison_table(evaluations: list[Evaluation]) -> Table:
         table.add_column(evaluation.policy, justify="right")
     for row in comparison_rows(evaluations):
         table.add_row(*row)
+    _fold(table)
     return table
 
 
@@ -72,35 +110,82 @@ def comparison_markdown(evaluations: list[Evaluation]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def plotted_measures(evaluations: list[Evaluation]) -> list[str]:
+    """The measures worth a panel: not 0 on every episode of every policy, and not
+    a repeat of an earlier measure's values (the sweeper's ``steps`` is its length)."""
+    kept: list[str] = []
+    columns: list[list[float]] = []
+    for key in evaluations[0].measures:
+        values = [e[key] for evaluation in evaluations for e in evaluation.episodes if key in e]
+        if not np.any(values) or values in columns:
+            continue
+        kept.append(key)
+        columns.append(values)
+    return kept
+
+
+def _bar_errors(means: list[float], half_widths: list[float], unit: str) -> np.ndarray:
+    """Lower and upper error-bar lengths: a rate's interval clipped to [0, 1], a
+    count's or duration's at 0."""
+    means_, half = np.asarray(means), np.asarray(half_widths)
+    lower = np.minimum(half, means_) if unit in RATE_UNITS + COUNT_UNITS else half
+    upper = np.minimum(half, 1.0 - means_) if unit in RATE_UNITS else half
+    return np.vstack([lower, upper])
+
+
 def comparison_figure(evaluations: list[Evaluation], path: Path) -> Path:
-    """A bar per policy for each measure, with 95 % interval error bars."""
-    measures = evaluations[0].measures
+    """A bar per policy for each plotted measure (:func:`plotted_measures`), with
+    95 % interval error bars, the measure and its unit on the y axis."""
+    measures = plotted_measures(evaluations) or ["return"]
     columns = min(4, len(measures))
     rows = -(-len(measures) // columns)
-    figure = Figure(figsize=(3.2 * columns, 2.8 * rows))
+    figure = Figure(figsize=(3.4 * columns, 3.0 * rows))
     axes = figure.subplots(rows, columns, squeeze=False)
     names = [evaluation.policy for evaluation in evaluations]
     summaries = [evaluation.summary() for evaluation in evaluations]
     for ax, key in zip(axes.flat, measures, strict=False):
         means = [summary[key]["mean"] for summary in summaries]
-        errors = [summary[key]["ci95"] for summary in summaries]
-        ax.bar(range(len(names)), means, yerr=errors, color=[f"C{i}" for i in range(len(names))])
+        unit = evaluations[0].units.get(key, "")
+        errors = _bar_errors(means, [summary[key]["ci95"] for summary in summaries], unit)
+        colors = [f"C{i}" for i in range(len(names))]
+        ax.bar(range(len(names)), means, yerr=errors, color=colors, capsize=3)
         ax.set_xticks(range(len(names)), names, rotation=30, ha="right", fontsize=7)
+        ax.set_ylabel(_unit(evaluations[0], key), fontsize=8)
         ax.set_title(key, fontsize=9)
+        if unit in RATE_UNITS:
+            ax.set_ylim(0.0, 1.05)
     for ax in list(axes.flat)[len(measures) :]:
-        ax.axis("off")
-    figure.suptitle(evaluations[0].env_id)
+        ax.remove()
+    n = sorted({len(evaluation.episodes) for evaluation in evaluations})
+    figure.suptitle(
+        f"{evaluations[0].env_id}: mean and 95 % interval over {' or '.join(map(str, n))} episodes",
+        fontsize=10,
+    )
     figure.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=110)
     return path
 
 
+def write_evaluation(evaluation: Evaluation, out_dir: Path, stem: str) -> list[Path]:
+    """``evaluate``'s files: ``<stem>_<policy>_evaluation.{json,csv,png}``.
+
+    Never the name of a file :func:`write_comparison` writes (those hold
+    ``_comparison``), so the two commands can share an output folder.
+    """
+    name = f"{stem}_{_file_safe(evaluation.policy)}_evaluation"
+    written = evaluation.write(out_dir, name)
+    written.append(comparison_figure([evaluation], out_dir / f"{name}.png"))
+    return written
+
+
 def write_comparison(evaluations: list[Evaluation], out_dir: Path, stem: str) -> list[Path]:
-    """Each policy's JSON/CSV, a combined JSON and the comparison figure."""
+    """``compare``'s files: each policy's ``<stem>_comparison_<policy>.{json,csv}``, and
+    ``<stem>_comparison.{json,md,png}`` (the combined JSON, the table, the figure)."""
     written: list[Path] = []
     for evaluation in evaluations:
-        written += evaluation.write(out_dir, f"{stem}_{_file_safe(evaluation.policy)}")
+        name = f"{stem}_comparison_{_file_safe(evaluation.policy)}"
+        written += evaluation.write(out_dir, name)
     combined = out_dir / f"{stem}_comparison.json"
     combined.write_text(json.dumps([e.to_json() for e in evaluations], indent=2))
     table = out_dir / f"{stem}_comparison.md"

@@ -1,9 +1,15 @@
-"""Shipping the best of a set of training runs into ``agents/pretrained/``."""
+"""Shipping the best of a set of training runs into ``agents/pretrained/``.
+
+A model already shipped under the same ID and label is evaluated on the same
+held-out episodes first; it is replaced only when the best run scores at
+least as well (success rate, then mean return), or when forced.
+"""
 
 from __future__ import annotations
 
 import json
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -51,9 +57,49 @@ def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:
     ]
 
 
+Score = tuple[float, float]  # (success rate, mean return) on the held-out episodes
+
+
+def score(summary: dict[str, dict[str, float]]) -> Score:
+    """What ``ship`` ranks by: success rate (0 without ``is_success``), then mean return."""
+    success = summary["is_success"]["mean"] if "is_success" in summary else 0.0
+    return success, summary["return"]["mean"]
+
+
+def describe(value: Score) -> str:
+    return f"success {100 * value[0]:.0f} %, mean return {value[1]:.4g}"
+
+
+@dataclass
+class Shipped:
+    """Where the model went, its score, and the replaced model's (None if none)."""
+
+    folder: Path
+    score: Score
+    previous: Score | None
+
+
+def _previous_score(folder: Path, env, env_id: str, seeds: range, label: str) -> Score | None:
+    """The score of the model shipped at ``folder`` on ``seeds``, None if none is there."""
+    if not (folder / "model.zip").is_file():
+        return None
+    try:
+        predictor = load_model(folder, env, env_id)
+    except UsageError as error:
+        raise UsageError(
+            f"the model shipped at {folder} cannot be evaluated ({error}); "
+            "--force replaces it unseen"
+        ) from error
+    return score(evaluate(env, predictor, seeds, env_id, label).summary())
+
+
 def ship(
-    run_dirs: list[Path], n_episodes: int = 20, seed: int | None = None, root: Path | None = None
-) -> Path:
+    run_dirs: list[Path],
+    n_episodes: int = 20,
+    seed: int | None = None,
+    root: Path | None = None,
+    force: bool = False,
+) -> Shipped:
     """Evaluate the runs of one ID and algorithm (training seeds) and ship the best.
 
     Every run is evaluated on the same ``n_episodes`` held-out seeds from
@@ -66,6 +112,10 @@ def ship(
     over every run's episodes (the reported "over seeds and episodes"
     figures); ``learning_curves.csv``: every run's evaluation-callback curve.
     The manifest is written last.
+
+    A model already in that folder is evaluated on the same episodes; if it
+    scores better than the best run, nothing is written and a
+    :class:`UsageError` gives both scores, unless ``force``.
     """
     if not run_dirs:
         raise UsageError("ship needs at least one run folder")
@@ -92,15 +142,17 @@ def ship(
                 **evaluation.to_json(),
             }
         )
-    env.close()
-
-    def score(run: dict) -> tuple[float, float]:
-        summary = run["summary"]
-        success = summary["is_success"]["mean"] if "is_success" in summary else 0.0
-        return success, summary["return"]["mean"]
-
-    best = max(range(len(runs)), key=lambda i: score(runs[i]))
+    best = max(range(len(runs)), key=lambda i: score(runs[i]["summary"]))
+    best_score = score(runs[best]["summary"])
     folder = (root or pretrained_root()) / short_name(env_id) / label
+    previous = None if force else _previous_score(folder, env, env_id, seeds, label)
+    env.close()
+    if previous is not None and previous > best_score:
+        raise UsageError(
+            f"not shipped: the model at {folder} scores better on the {n_episodes} held-out "
+            f"episodes ({describe(previous)}) than the best run {runs[best]['run']} "
+            f"({describe(best_score)}); --force replaces it anyway"
+        )
     if folder.is_dir():
         shutil.rmtree(folder)
     folder.mkdir(parents=True)
@@ -121,4 +173,4 @@ def ship(
         rows += _learning_curve_rows(run_dir, config["seed"])
     (folder / LEARNING_CURVES).write_text("\n".join(rows) + "\n")
     write_manifest(folder)
-    return folder
+    return Shipped(folder, best_score, previous)

@@ -37,6 +37,7 @@ import numpy as np
 import torch
 import yaml
 from matplotlib.figure import Figure
+from matplotlib.ticker import EngFormatter
 from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import (
@@ -135,7 +136,8 @@ def learning_curve_figure(evaluations_file: Path, path: Path, title: str) -> Pat
     ax.plot(steps, mean)
     ax.fill_between(steps, mean - std, mean + std, alpha=0.3)
     ax.set_xlabel("environment steps")
-    ax.set_ylabel("evaluation return")
+    ax.xaxis.set_major_formatter(EngFormatter(sep=""))  # 200k, 1M: no run-together labels
+    ax.set_ylabel("evaluation return (training reward, mean ± std)")
     ax.set_title(title, fontsize=9)
     figure.tight_layout()
     figure.savefig(path, dpi=110)

@@ -162,10 +162,22 @@ def params_from_kwargs(cls: type[P], kwargs: Mapping[str, Any], ignore: Iterable
 
 
 def check_render_mode(render_mode: Any, allowed: Sequence[str]) -> str | None:
-    """``render_mode`` if it is None or one of ``allowed``."""
+    """``render_mode`` if it is None or one of ``allowed``; ``"human"`` only where a
+    window can open (:func:`~motiongym.envs.rendering.missing_display`)."""
     if render_mode is None:
         return None
-    return check_choice("render_mode", render_mode, (None, *allowed))
+    mode = check_choice("render_mode", render_mode, (None, *allowed))
+    if mode == "human":
+        from motiongym.envs.rendering import missing_display
+
+        problem = missing_display()
+        if problem is not None:
+            raise ArgumentError(
+                f"render_mode='human' needs a display to open a window ({problem}); "
+                "use render_mode='rgb_array' or `motiongym record`, or run under a "
+                "virtual display (xvfb-run)"
+            )
+    return mode
 
 
 def check_options(

@@ -16,9 +16,10 @@ from motiongym.envs.dual_arm import task as task_module
 from motiongym.envs.dual_arm.params import CONTROLS, WEIGHTS, DualArmParams
 from motiongym.envs.dual_arm.task import DT, TASK_MODES
 from motiongym.envs.dual_arm.world import OBS, DualArmWorld, observation_bounds
+from motiongym.envs.rendering import Renders
 
 
-class DualArmCellEnv(gym.Env):
+class DualArmCellEnv(Renders, gym.Env):
     """Two PUMA-560 arms, each on a fixed pick-and-place trajectory; avoid collisions
     by timing alone (Chang, Chung & Lee: time delay by boundary following).
 
@@ -107,6 +108,7 @@ class DualArmCellEnv(gym.Env):
     1 mm of resolution, never missed).
 
     ## Version history
+
     * v1: ``collision_check="swept"``: collisions between control samples
       count (an undelayed pair that grazed between two 20 ms samples passed
       v0's check).
@@ -114,7 +116,7 @@ class DualArmCellEnv(gym.Env):
     """
 
     metadata = {
-        "render_modes": ["rgb_array"],
+        "render_modes": ["rgb_array", "human"],
         "render_fps": int(1 / DT),
         "info_measures": {
             "is_success": "last",
@@ -123,6 +125,14 @@ class DualArmCellEnv(gym.Env):
             "distance": "min",
             "makespan": "last",
             "robot_2_wait": "last",
+        },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "collision": "rate",
+            "distance": "m",
+            "makespan": "s",
+            "robot_2_wait": "s",
         },
     }
 
@@ -172,6 +182,7 @@ class DualArmCellEnv(gym.Env):
         self.world.load(*task_module.sample_pair(self.np_random, mode, self.safety_margin))
         self._wait2 = 0.0
         info = self._info(collided=False, terms={k: 0.0 for k in self.weights})
+        self._show_if_human()
         return self.world.observation(), info
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -195,14 +206,14 @@ class DualArmCellEnv(gym.Env):
         }
         reward = sum(terms.values())
         terminated = collided or (w.p1 >= w.n1 and w.p2 >= w.n2)
+        self._show_if_human()
         return w.observation(), float(reward), terminated, False, self._info(collided, terms)
 
-    def render(self) -> np.ndarray | None:
-        if self.render_mode != "rgb_array":
-            return None
+    def _frame(self) -> np.ndarray:
         return self.world.render()
 
     def close(self) -> None:
+        super().close()
         self.world.close()
 
     # ------------------------------------------------------------------ helpers

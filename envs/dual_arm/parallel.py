@@ -28,7 +28,7 @@ class DualArmParallelEnv(ParallelEnv):
 
     metadata = {
         "name": "dual_arm_cell_v0",
-        "render_modes": ["rgb_array"],
+        "render_modes": ["rgb_array", "human"],
         "is_parallelizable": True,
     }
 

@@ -30,7 +30,7 @@ from motiongym.envs.excavator import observation as obs_layout
 from motiongym.envs.excavator.params import params_for
 from motiongym.envs.excavator.task import DigTask, ReachTask
 from motiongym.envs.excavator.world import ExcavatorWorld
-from motiongym.envs.rendering import OwnsRenderer
+from motiongym.envs.rendering import Renders
 
 # Observation fields q ... fill written as float32 straight into the buffer: the
 # same rounding as NumPy's cast, without converting a list.
@@ -41,8 +41,8 @@ _COMMON_INFO = """
     checked at construction, limits in its table): ``machine`` (dict of
     :class:`Machine` overrides), ``dt`` (s), ``pipe_safety`` (m),
     ``physics`` ("v0" or "v1"), ``slope`` (rad, v1), the task's tolerances,
-    the reward weights, ``render_mode`` ("rgb_array"), ``render_size``
-    (rows, columns).
+    the reward weights, ``render_mode`` ("rgb_array", or "human": a window,
+    see :mod:`motiongym.envs.rendering`), ``render_size`` (rows, columns).
 
     ``info`` (every step and reset): ``is_success``; ``cost`` (1.0 on a step
     where the pipe clearance is below ``pipe_safety``, 0.5 m by default: the
@@ -68,10 +68,10 @@ _COMMON_INFO = """
 """
 
 
-class ExcavatorBase(NeedsReset, OwnsRenderer, gym.Env):
+class ExcavatorBase(NeedsReset, Renders, gym.Env):
     """Shared wiring; see :class:`ExcavatorReachEnv` and :class:`ExcavatorEnv`."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
     TASK: type = ReachTask
 
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
@@ -117,6 +117,7 @@ class ExcavatorBase(NeedsReset, OwnsRenderer, gym.Env):
         self.task.reset(self.world, self._obs)
         self._was_reset = True
         _, info = self._reward_and_info(zero_terms(self.TASK.REWARD_TERMS), False)
+        self._show_if_human()
         return self._observation(), info
 
     def step(self, action):
@@ -127,6 +128,7 @@ class ExcavatorBase(NeedsReset, OwnsRenderer, gym.Env):
         terms, success = self.task.step(world)
         reward, info = self._reward_and_info(terms, success)
         terminated = bool(success or world.contact)
+        self._show_if_human()
         return self._observation(), reward, terminated, False, info
 
     def _observation(self) -> np.ndarray:
@@ -159,11 +161,7 @@ class ExcavatorBase(NeedsReset, OwnsRenderer, gym.Env):
             **self.task.measures(w),
         )
 
-    def render(self):
-        self._require_reset("render")
-        if self.render_mode is None:
-            gym.logger.warn("render() called without render_mode; pass render_mode='rgb_array'")
-            return None
+    def _frame(self) -> np.ndarray:
         if self._renderer is None:
             from motiongym.envs.excavator.render_scene import SceneRenderer
 
@@ -243,6 +241,15 @@ class ExcavatorReachEnv(ExcavatorBase):
             "truck_clearance": "min",
             "elapsed": "last",
         },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "position_error": "m",
+            "angle_error": "rad",
+            "pipe_clearance": "m",
+            "truck_clearance": "m",
+            "elapsed": "s",
+        },
     }
 
 
@@ -270,7 +277,7 @@ class ExcavatorEnv(ExcavatorBase):
     completed cycle); ``spill`` = -spill * soil spilled (m3);
     ``clearance`` = -clearance on a step with cost; ``contact`` = -contact
     on contact; ``time`` = -time per step; ``success`` = +success on success;
-    ``approach`` = approach * (|tip_prev - g| - |tip - g|), the step's
+    ``approach`` = ``approach * (|tip_prev - g| - |tip - g|)``, the step's
     progress (m) toward the subgoal g of :meth:`DigTask.subgoal`, 0 in the
     registered ID: a dense shaping for training (configs) that draws the
     bucket into the middle of the zone at the marked depth while it holds
@@ -312,6 +319,18 @@ class ExcavatorEnv(ExcavatorBase):
             "pipe_clearance": "min",
             "truck_clearance": "min",
             "elapsed": "last",
+        },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "dig_fill": "m3",
+            "outside_zone": "m3",
+            "truck_soil": "m3",
+            "spill": "m3",
+            "pipe_contact": "rate",
+            "pipe_clearance": "m",
+            "truck_clearance": "m",
+            "elapsed": "s",
         },
     }
 

@@ -28,10 +28,10 @@ from motiongym.envs.harvest_arm.task import (
     scene_from_obstacles,
 )
 from motiongym.envs.harvest_arm.world import HarvestArmWorld
-from motiongym.envs.rendering import OwnsRenderer
+from motiongym.envs.rendering import Renders
 
 
-class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
+class HarvestArmEnv(NeedsReset, Renders, gym.Env):
     """Bring a redundant arm's gripper to a fruit while its links keep clear.
 
     The arm of Ryu et al. (fruit-harvesting redundant robot) among immature
@@ -119,7 +119,7 @@ class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
     """
 
     metadata = {
-        "render_modes": ["rgb_array"],
+        "render_modes": ["rgb_array", "human"],
         "render_fps": 20,
         "info_measures": {
             "is_success": "last",
@@ -128,6 +128,14 @@ class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
             "close_approach": "max",
             "min_distance": "min",
             "distance_to_fruit": "last",
+        },
+        "info_units": {
+            "is_success": "rate",
+            "cost": "steps",
+            "collision": "rate",
+            "close_approach": "rate",
+            "min_distance": "m",
+            "distance_to_fruit": "m",
         },
     }
 
@@ -225,6 +233,7 @@ class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
         self._min_so_far = self.world.min_distance
         self._path = [self.world.gripper_3d()]
         self._was_reset = True
+        self._show_if_human()
         return self._obs.copy(), self._info(False, False, zero_terms(self.weights))
 
     # ------------------------------------------------------------------- step
@@ -255,6 +264,7 @@ class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
             self._path.append(self.world.gripper_3d())
         terminated = bool(arrived or (collided and self.params.terminate_on_collision))
         reward, info = self._reward_and_info(arrived, collided, terms)
+        self._show_if_human()
         return self._obs.copy(), reward, terminated, False, info
 
     def _update(self, qdot: np.ndarray) -> None:
@@ -297,10 +307,7 @@ class HarvestArmEnv(NeedsReset, OwnsRenderer, gym.Env):
         return self._reward_and_info(arrived, collided, terms)[1]
 
     # ----------------------------------------------------------------- render
-    def render(self) -> np.ndarray | None:
-        self._require_reset("render")
-        if self.render_mode != "rgb_array":
-            return None
+    def _frame(self) -> np.ndarray:
         if self._renderer is None:
             self._renderer = mujoco.Renderer(
                 self.world.model, self.params.height, self.params.width

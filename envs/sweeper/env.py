@@ -15,6 +15,7 @@ from motiongym.envs.core import (
     reward_and_info,
     zero_terms,
 )
+from motiongym.envs.rendering import Renders
 from motiongym.envs.sweeper import maps, task
 from motiongym.envs.sweeper.measures import measures
 from motiongym.envs.sweeper.params import SweeperParams
@@ -25,7 +26,7 @@ from motiongym.envs.sweeper.world import FORWARD, LEFT, RIGHT, World
 __all__ = ["FORWARD", "LEFT", "RIGHT", "SweeperEnv"]
 
 
-class SweeperEnv(NeedsReset, gym.Env):
+class SweeperEnv(NeedsReset, Renders, gym.Env):
     """Sweep every reachable free cell of an unknown closed area (Park & Lee 1998).
 
     The world is an occupancy bitmap (paper 4.1). The robot is a square of
@@ -43,6 +44,7 @@ class SweeperEnv(NeedsReset, gym.Env):
     see-through variant: every obstacle in the window is sensed.
 
     ## Action space: ``Discrete(3)``
+
     ===== ==========================================================
     0     move forward one cell (a move into an obstacle is a bump:
           the robot stays and senses it)
@@ -135,7 +137,7 @@ class SweeperEnv(NeedsReset, gym.Env):
     Anything else (another key, a non-dict ``options``) is a ValueError.
 
     ## Keyword arguments
-    ``render_mode`` (None or "rgb_array") and the world's parameters, each
+    ``render_mode`` (None, "rgb_array", or "human": a window) and the world's parameters, each
     checked at construction (type, finiteness, range, size limits; see
     :class:`~motiongym.envs.sweeper.params.SweeperParams` for the table):
     ``map_name`` ("room", "apartment", "maze", "random", "random-room",
@@ -153,6 +155,7 @@ class SweeperEnv(NeedsReset, gym.Env):
     ``reset()`` raise RuntimeError.
 
     ## Version history
+
     - v1: line-of-sight sensing (an obstacle hides what lies behind it) and
       the ``known`` observation key telling unknown from free.
     - v0: first version; the window sees through walls (kept as the
@@ -160,7 +163,7 @@ class SweeperEnv(NeedsReset, gym.Env):
     """
 
     metadata = {
-        "render_modes": ["rgb_array"],
+        "render_modes": ["rgb_array", "human"],
         "render_fps": 30,
         "info_measures": {
             "coverage": "last",
@@ -172,6 +175,17 @@ class SweeperEnv(NeedsReset, gym.Env):
             "steps": "last",
             "cost": "sum",
             "is_success": "last",
+        },
+        "info_units": {
+            "coverage": "fraction",
+            "travel": "cells",
+            "travel_ratio": "ratio",
+            "overlap": "fraction",
+            "turns": "count",
+            "bumps": "count",
+            "steps": "steps",
+            "cost": "steps",
+            "is_success": "rate",
         },
     }
 
@@ -219,6 +233,7 @@ class SweeperEnv(NeedsReset, gym.Env):
         self.world.reset(scenario)
         self._was_reset = True
         _, info = self._reward_and_info(zero_terms(task.REWARD_TERMS))
+        self._show_if_human()
         return self.world.observation(), info
 
     def step(self, action: Any) -> tuple[dict, float, bool, bool, dict]:
@@ -228,6 +243,7 @@ class SweeperEnv(NeedsReset, gym.Env):
         new = self.world.advance(action, self.np_random)
         s = self.world.state
         reward, info = self._reward_and_info(task.reward_terms(new, s.bump, self.params))
+        self._show_if_human()
         return self.world.observation(), reward, info["is_success"], False, info
 
     def _checked_action(self, action: Any) -> int:
@@ -264,8 +280,5 @@ class SweeperEnv(NeedsReset, gym.Env):
         """(3,) bool: which actions are allowed (see "Action masks" above)."""
         return self.world.action_masks()
 
-    def render(self) -> np.ndarray | None:
-        self._require_reset("render")
-        if self.render_mode != "rgb_array":
-            return None
+    def _frame(self) -> np.ndarray:
         return draw(self.world.state, self.params.robot_width, self.params.cell_pixels)

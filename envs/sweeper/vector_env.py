@@ -9,7 +9,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from motiongym.envs.core import check_int, check_options, zero_terms
+from motiongym.envs.core import check_int, check_options, check_render_mode, zero_terms
 from motiongym.envs.sweeper import sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
 from motiongym.envs.sweeper.measures import INFO_KEYS, batch_info, measures
@@ -95,6 +95,7 @@ class SweeperVectorEnv(VectorEnv):
         "render_fps": 30,
         "autoreset_mode": AutoresetMode.SAME_STEP,
         "info_measures": dict(SweeperEnv.metadata["info_measures"]),
+        "info_units": dict(SweeperEnv.metadata["info_units"]),
     }
     recycle_observations = True  # False: fresh observation arrays on every call (slower)
 
@@ -106,6 +107,7 @@ class SweeperVectorEnv(VectorEnv):
         **kwargs: Any,
     ) -> None:
         N = check_int("num_envs", num_envs, 1, MAX_NUM_ENVS)
+        render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
         max_episode_steps = check_int("max_episode_steps", max_episode_steps, 1)
         # The single environment validates the keywords and holds the spaces.
         self._single = single = SweeperEnv(render_mode=render_mode, **kwargs)

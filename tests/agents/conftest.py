@@ -36,4 +36,4 @@ def shipped_folder(tmp_path_factory):
         )
         for seed in (0, 1)
     ]
-    return ship(run_dirs, n_episodes=2, root=root / "pretrained")
+    return ship(run_dirs, n_episodes=2, root=root / "pretrained").folder

@@ -178,7 +178,17 @@ def test_no_traceback_from_the_installed_command(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "argv", [["list"], ["evaluate"], ["compare"], ["train"], ["reproduce"], ["ship"], ["bench"]]
+    "argv",
+    [
+        ["list"],
+        ["evaluate"],
+        ["compare"],
+        ["train"],
+        ["reproduce"],
+        ["ship"],
+        ["bench"],
+        ["record"],
+    ],
 )
 def test_every_subcommand_has_help(argv, capsys):
     with pytest.raises(SystemExit) as exit_info:

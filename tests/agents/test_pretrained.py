@@ -75,3 +75,33 @@ def test_ship_refuses_runs_of_different_ids(shipped_folder, tmp_path):
     runs = shipped_folder.parent.parent.parent / "runs" / "ExcavatorReach-v0"
     with pytest.raises(UsageError, match="one ID and algorithm"):
         ship([next(runs.iterdir()), other], n_episodes=1, root=tmp_path / "pretrained")
+
+
+def test_ship_keeps_a_better_shipped_model_unless_forced(shipped_folder, tmp_path, capsys):
+    """A temporary copy of a shipped folder stands for agents/pretrained: the worse
+    training run is refused with both scores, --force replaces, an equal run ships."""
+    from motiongym.agents.cli import main
+
+    metrics = json.loads((shipped_folder / "metrics.json").read_text())
+    ranked = sorted(metrics["runs"], key=lambda run: run["summary"]["return"]["mean"])
+    worse, best = (ranked[0], ranked[-1])
+    assert worse["summary"]["return"]["mean"] < best["summary"]["return"]["mean"]
+    runs = shipped_folder.parent.parent.parent / "runs" / "ExcavatorReach-v0"
+    root = tmp_path / "pretrained"
+    shutil.copytree(shipped_folder, root / "ExcavatorReach-v0" / "ppo")
+    before = (root / "ExcavatorReach-v0" / "ppo" / "model.zip").read_bytes()
+    argv = ["ship", str(runs / worse["run"]), "--episodes", "2", "--into", str(root)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    best_return = f"mean return {best['summary']['return']['mean']:.4g}"
+    worse_return = f"mean return {worse['summary']['return']['mean']:.4g}"
+    assert "not shipped" in err and best_return in err and worse_return in err
+    assert "--force" in err
+    assert (root / "ExcavatorReach-v0" / "ppo" / "model.zip").read_bytes() == before
+    assert main([*argv, "--force"]) == 0
+    replaced = json.loads((root / "ExcavatorReach-v0" / "ppo" / "metrics.json").read_text())
+    assert replaced["shipped_run"] == worse["run"]
+    argv = ["ship", str(runs / best["run"]), "--episodes", "2", "--into", str(root)]
+    assert main(argv) == 0  # better than what is there now: shipped, both scores printed
+    out = capsys.readouterr().out
+    assert best_return in out and f"replaced a model with success 0 %, {worse_return}" in out

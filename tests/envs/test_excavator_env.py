@@ -22,7 +22,7 @@ ALL_IDS = (*IDS, "motiongym/ExcavatorReach-v1", "motiongym/Excavator-v1")
 
 
 @pytest.mark.parametrize("env_id", ALL_IDS)
-def test_api_checks(env_id):
+def test_api_checks(env_id, drawing_display):
     env = gym.make(env_id, render_mode="rgb_array")
     check_env(env.unwrapped)
     sb3_check_env(env.unwrapped, warn=False)
