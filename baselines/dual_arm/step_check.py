@@ -35,9 +35,11 @@ import numpy as np
 
 from motiongym.envs.dual_arm import model, motion
 from motiongym.envs.dual_arm.task import Trajectory
+from motiongym.envs.geometry import closest_points_between_segments
 
 UNKNOWN, CLEAR, HIT, NEAR, COLLIDES = -1, 0, 1, 2, 3
 TILE = 8
+REACH = (model.HALF + model.RADII)[:, None] + (model.HALF + model.RADII)[None, :]  # (5, 5)
 
 
 class StepCheck:
@@ -65,6 +67,8 @@ class StepCheck:
         self.hi2 = np.concatenate([[0], np.minimum(np.arange(n2 + 1) + 1, n2)])
         self.seg1 = model.link_segments(self.q1, model.base_transform(0))  # (N1+1, 5, 3) x2
         self.seg2 = model.link_segments(self.q2, model.base_transform(1))
+        self.centres1 = (self.seg1[0] + self.seg1[1]) / 2  # (N1 + 1, 5, 3)
+        self.centres2 = (self.seg2[0] + self.seg2[1]) / 2
         self.move1 = motion.body_motion(np.abs(self.q1[self.hi1] - self.q1[self.lo1]))
         self.move2 = motion.body_motion(np.abs(self.q2[self.hi2] - self.q2[self.lo2]))
         self.state = np.full((n1 + 1, n2 + 2), UNKNOWN, dtype=np.int8)
@@ -80,11 +84,28 @@ class StepCheck:
         a2, b2 = self.seg2
         return model.segment_pair_distances(a1[s1], b1[s1], a2[s2], b2[s2])
 
+    def _bounded_distances(self, s1: np.ndarray, s2: np.ndarray, slack: np.ndarray) -> np.ndarray:
+        """(n, 5, 5) link distances where ``d - slack`` may reach the margin, elsewhere a
+        lower bound above ``margin + slack``: the capsule centres' distance less both
+        capsules' reach (half length plus radius). Screens the same as exact distances."""
+        c1, c2 = self.centres1[s1], self.centres2[s2]  # (n, 5, 3)
+        diff = c1[:, :, None, :] - c2[:, None, :, :]
+        d = np.sqrt(np.einsum("nijk,nijk->nij", diff, diff)) - REACH
+        near = np.nonzero(d - slack <= self.margin)
+        if len(near[0]):
+            n, i, j = near
+            (a1, b1), (a2, b2) = self.seg1, self.seg2
+            exact, _, _ = closest_points_between_segments(
+                a1[s1[n], i], b1[s1[n], i], a2[s2[n], j], b2[s2[n], j]
+            )
+            d[near] = exact - model.RADII[i] - model.RADII[j]
+        return d
+
     def screen_entries(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Screen (stage 1) the given entries, whatever their state; returns their screen."""
-        d_lo = self._distances(self.lo1[rows], self.lo2[cols])
-        d_hi = self._distances(self.hi1[rows], self.hi2[cols])
         slack = self.move1[rows][:, :, None] / 2 + self.move2[cols][:, None, :] / 2
+        d_lo = self._bounded_distances(self.lo1[rows], self.lo2[cols], slack)
+        d_hi = self._bounded_distances(self.hi1[rows], self.hi2[cols], slack)
         hit = np.minimum(d_lo.min(axis=(1, 2)), d_hi.min(axis=(1, 2))) <= self.margin
         low = np.minimum((d_lo - slack).min(axis=(1, 2)), (d_hi - slack).min(axis=(1, 2)))
         return np.where(hit, HIT, np.where(low > self.margin, CLEAR, NEAR)).astype(np.int8)
@@ -98,7 +119,8 @@ class StepCheck:
             rows, cols = rows[unknown], cols[unknown]
             self.state[rows, cols] = self.screen_entries(rows, cols)
             return
-        tiles = np.unique(np.stack([rows[unknown], cols[unknown]], 1) // TILE, axis=0)
+        keys = zip((rows[unknown] // TILE).tolist(), (cols[unknown] // TILE).tolist(), strict=True)
+        tiles = np.array(sorted(set(keys)), dtype=np.int64)  # (n, 2)
         offsets = np.indices((TILE, TILE)).reshape(2, -1).T  # (TILE^2, 2)
         idx = (tiles[:, None, :] * TILE + offsets[None]).reshape(-1, 2)
         idx = idx[(idx[:, 0] <= self.n1) & (idx[:, 1] <= self.n2 + 1)]
@@ -112,30 +134,26 @@ class StepCheck:
         return self.state[rows, cols] == HIT
 
     def collides(self, rows: np.ndarray, cols: np.ndarray, first: bool = False) -> np.ndarray:
-        """bool: the environment's verdict on each step (halving the ``NEAR`` ones).
+        """bool: the environment's verdict on each step (halving the ``NEAR`` ones at once).
 
-        With ``first``, stops halving at the first collision found (the other
-        undecided entries are then reported clear: use where only ``any()`` matters).
+        With ``first``, no halving where an entry is already known to collide
+        (the undecided ones are then reported clear: use where only ``any()`` matters).
         """
         rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
         self._screen(rows, cols, tiles=False)
-        found = np.isin(self.state[rows, cols], (HIT, COLLIDES))
-        if first and found.any():
-            return found
-        for i in np.flatnonzero(self.state[rows, cols] == NEAR):
-            self.state[rows[i], cols[i]] = self.decide(int(rows[i]), int(cols[i]))
-            found[i] = self.state[rows[i], cols[i]] == COLLIDES
-            if first and found[i]:
-                break
-        return found
+        near = self.state[rows, cols] == NEAR
+        if near.any() and not (first and np.isin(self.state[rows, cols], (HIT, COLLIDES)).any()):
+            self.decide(rows[near], cols[near])
+        return np.isin(self.state[rows, cols], (HIT, COLLIDES))
 
-    def decide(self, row: int, col: int) -> int:
-        """Stage 2 for one entry: ``COLLIDES`` or ``CLEAR`` by halving."""
-        self.halvings += 1
-        span1 = (float(self.lo1[row]), float(self.hi1[row]))
-        span2 = (float(self.lo2[col]), float(self.hi2[col]))
-        hit = motion.simultaneous_collide(self.q1, span1, self.q2, span2, self.margin)
-        return COLLIDES if hit else CLEAR
+    def decide(self, rows: np.ndarray, cols: np.ndarray) -> None:
+        """Stage 2: entries ``COLLIDES`` or ``CLEAR`` by halving, all at once."""
+        rows, cols = np.divmod(np.unique(rows * self.shape[1] + cols), self.shape[1])
+        self.halvings += len(rows)
+        spans1 = np.stack([self.lo1[rows], self.hi1[rows]], 1)
+        spans2 = np.stack([self.lo2[cols], self.hi2[cols]], 1)
+        hit = motion.simultaneous_collide_many(self.q1, spans1, self.q2, spans2, self.margin)
+        self.state[rows, cols] = np.where(hit, COLLIDES, CLEAR)
 
     def table(self) -> np.ndarray:
         """(N1 + 1, N2 + 2) bool: every entry's verdict (the brute force's table)."""
