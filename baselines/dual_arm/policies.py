@@ -46,7 +46,9 @@ class SchedulePolicy(ScriptedPolicy):
             (``schedules.collides_at_samples``); where the map's length
             discretisation hid a graze, plan again with the map's margin raised
             by ``replan_step`` (m), at most ``max_replans`` times, then fall back
-            to sequential operation. The memory records ``margin`` and ``replans``.
+            to sequential operation (v1: to the exact minimum pure delay). The
+            memory records ``margin`` and ``replans`` (the guard's firings); a
+            plan that says no pure delay exists (``reason``) is not re-planned.
     """
 
     def __init__(
@@ -89,6 +91,8 @@ class SchedulePolicy(ScriptedPolicy):
             plan = self.plan(cmap, memory)
             memory.update(map=cmap, replans=replans)
             collides = schedules.collides_swept if self.swept else schedules.collides_at_samples
+            if memory.get("reason"):  # no pure delay exists: nothing to re-plan
+                return plan
             if not (self.verify and self.verifiable) or not collides(
                 traj1, traj2, plan.advances, self.safety_margin
             ):
