@@ -25,7 +25,11 @@ from typing import Any
 
 import numpy as np
 
-from motiongym.agents.reproduce.dual_arm_truth import print_truth_study, truth_study
+from motiongym.agents.reproduce.dual_arm_truth import (
+    print_truth_study,
+    resolution_study,
+    truth_study,
+)
 from motiongym.baselines.dual_arm import schedules
 from motiongym.baselines.dual_arm.boundary_following import BoundaryResult, boundary_following
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
@@ -342,13 +346,22 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
     _study_figure(out_dir, res)
     _print(case, res)
     truth = truth_study([SEED0 + i for i in range(3 if quick else TRUTH_PAIRS)])
-    print_truth_study(truth)
-    numbers = {"paper": PAPER, "paper_case": case, "study": res, "truth": truth}
+    seeds = [SEED0 + i for i in range(2 if quick else RESOLUTION_PAIRS)]
+    resolution = resolution_study(seeds, (50, 100) if quick else (50, 100, 200, 400))
+    print_truth_study(truth, resolution)
+    numbers = {
+        "paper": PAPER,
+        "paper_case": case,
+        "study": res,
+        "truth": truth,
+        "resolution": resolution,
+    }
     (out_dir / "dual_arm.json").write_text(json.dumps(numbers, indent=2, default=_jsonable))
     return numbers
 
 
-TRUTH_PAIRS = 40  # pairs judged against the brute force (about 2.5 s a pair)
+TRUTH_PAIRS = 200  # pairs judged against the brute force (about 1.5 s a pair)
+RESOLUTION_PAIRS = 40  # pairs of the N_l study
 
 
 def _jsonable(value: Any) -> Any:
