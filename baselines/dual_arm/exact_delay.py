@@ -20,6 +20,8 @@ decided) and nothing of the collision maps or of boundary following.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from motiongym.baselines.dual_arm.step_check import StepCheck
@@ -59,3 +61,15 @@ def solve_paper_case() -> int | None:
     from motiongym.envs.dual_arm.task import paper_case
 
     return true_min_delay(*paper_case())
+
+
+_turn = itertools.count()
+
+
+def solve_sampled_pair() -> int | None:
+    """The brute force on the next of the pairs that ``bracket.plan_sampled_pair`` times
+    (a benchmark hook, in the same turn order)."""
+    from motiongym.baselines.dual_arm.bracket import bench_pairs
+
+    pairs = bench_pairs()
+    return true_min_delay(*pairs[next(_turn) % len(pairs)])
