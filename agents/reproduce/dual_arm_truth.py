@@ -104,8 +104,10 @@ def summarise(rows: list[dict[str, object]]) -> dict[str, object]:
 
 
 def truth_study(seeds: list[int], n_levels: int = 100) -> dict[str, object]:
-    """Every method against the truth on the pairs of ``seeds``."""
-    return summarise([study_pair(seed, n_levels) for seed in seeds])
+    """Every method against the truth on the pairs of ``seeds``; the at-rest pairs."""
+    summary = summarise([study_pair(seed, n_levels) for seed in seeds])
+    summary["at_rest"] = at_rest_study()
+    return summary
 
 
 def resolution_study(seeds: list[int], levels=(50, 100, 200, 400)) -> dict[int, dict]:
@@ -137,6 +139,28 @@ def resolution_study(seeds: list[int], levels=(50, 100, 200, 400)) -> dict[int, 
     return out
 
 
+def at_rest_pair(where: str) -> tuple[task.Trajectory, task.Trajectory]:
+    """The paper case with both arms starting (``where="start"``) or ending ("end") where
+    they are at 0.9 s, where the undelayed pair collides: no delay can help."""
+    traj1, traj2 = task.paper_case()
+    vias1, vias2 = traj1.vias.copy(), traj2.vias.copy()
+    index = 0 if where == "start" else -1
+    vias1[index], vias2[index] = traj1.at_time(np.array(0.9)), traj2.at_time(np.array(0.9))
+    return (
+        task.Trajectory(vias1, traj1.durations, 0),
+        task.Trajectory(vias2, traj2.durations, 1),
+    )
+
+
+def at_rest_study() -> dict[str, object]:
+    """What the planner answers on the two at-rest pairs (a reason, never a delay)."""
+    out = {}
+    for where in ("start", "end"):
+        plan = exact_delay_search(*at_rest_pair(where))
+        out[where] = {"delay": plan.delay, "reason": plan.reason}
+    return out
+
+
 def _spread(late: list[int]) -> str:
     return f"{len(late)}: {min(late)}-{max(late)}, median {np.median(late):g}" if late else "0"
 
@@ -165,6 +189,10 @@ def print_truth_study(summary: dict[str, object], resolution: dict[int, dict] | 
         f"exact delays colliding on a {FINE}-instant grid per step: "
         f"{summary['exact_fine_collisions']}; most delays checked exactly: {summary['checked_max']}"
     )
+    for where, answer in summary.get("at_rest", {}).items():
+        console.print(
+            f"arms colliding at rest ({where}): delay {answer['delay']}, {answer['reason']}"
+        )
     if not resolution:
         return
     res = Table(title="Map resolution N_l (BF + exact checks; d_lo: BF on the lower map)")

@@ -55,5 +55,9 @@ def test_truth_study(numbers):
     assert truth["pairs"] == 3
     assert truth["exact"]["equal"] == 3 and truth["exact_fine_collisions"] == 0
     assert truth["exact"]["early"] == truth["exact"]["failed"] == 0
+    assert (
+        truth["at_rest"]["start"]["delay"] is None
+        and "at rest" in truth["at_rest"]["end"]["reason"]
+    )
     for n_levels in (50, 100):
         assert numbers["resolution"][n_levels]["equal"] == 2

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
+from motiongym.agents.reproduce.dual_arm_truth import at_rest_pair
 from motiongym.baselines import make_policy
 from motiongym.baselines.dual_arm import bracket, schedules
 from motiongym.baselines.dual_arm.boundary_following import boundary_following
@@ -19,7 +20,6 @@ from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.dual_arm.exact_delay import free_delays, step_table
 from motiongym.baselines.dual_arm.step_check import StepCheck
 from motiongym.envs.dual_arm import motion, task
-from motiongym.envs.dual_arm.task import Trajectory
 
 V1 = "motiongym/DualArmCell-v1"
 KW = {**gym.spec(V1).kwargs, "control": "robot_2"}  # what the policy is told of the env
@@ -114,22 +114,9 @@ def test_ablations_each_part_earns_its_place():
     assert upper == 26 and not check.delay_collides(upper)
 
 
-def _at_rest(where):
-    """The paper case with robot 2 starting (or ending) where robot 1 is at 0.9 s."""
-    t1, t2 = task.paper_case()
-    grazing = t2.at_time(np.array(0.9))  # the undelayed pair collides at 0.9 s
-    hit = t1.at_time(np.array(0.9))
-    vias1, vias2 = t1.vias.copy(), t2.vias.copy()
-    if where == "start":
-        vias1[0], vias2[0] = hit, grazing
-    else:
-        vias1[-1], vias2[-1] = hit, grazing
-    return Trajectory(vias1, t1.durations, 0), Trajectory(vias2, t2.durations, 1)
-
-
 @pytest.mark.parametrize("where", ["start", "end"])
 def test_arms_that_collide_at_rest_are_reported_not_delayed(where):
-    t1, t2 = _at_rest(where)
+    t1, t2 = at_rest_pair(where)
     plan = bracket.exact_delay_search(t1, t2)
     assert plan.delay is None
     assert plan.reason == f"the arms collide at rest ({where} configurations)"
