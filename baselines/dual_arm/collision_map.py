@@ -10,6 +10,16 @@ cached; :attr:`CollisionMap.evaluated` counts the distinct cells computed
 ``s1 < 0``, ``s2 < 0`` and ``s2 > N_l`` are walls (blocked): robot 2 cannot
 run before its start or past its end.
 
+Three kinds of cells: the paper's (one configuration each: exact at no
+instant of the motion, so a delay may be early or late on the environment's
+check), the swept ones (any configuration of robot 1's step against any of
+robot 2's level interval: safe but late by 1-3 samples, since the two arms
+never take every pair of these configurations at once), and cells that are
+verdicts of ``DualArmCell-v1``'s own step check (:meth:`CollisionMap.from_steps`:
+an upper map, safe, and a lower map, never blocking a feasible delay; the
+v1 policy searches the lower one and checks its delay exactly,
+:mod:`.bracket`).
+
 TLVST (travelled length versus sampling time): ``tl[k] = floor(l(k dt) / dl)``,
 the level robot 2 has reached at its own sample ``k`` (``tl[N2] = N_l``). As a
 path of the paper's moves "0" (+s1) and "1" (+s2), the curve delayed by ``D``

@@ -10,7 +10,8 @@ robot 2 the schedule's 0 or 1. Works for ``control="both"`` (action (2,)) and
 ``control="robot_2"`` (action (1,)).
 
 Policies: ``boundary-following`` (the paper; falls back to sequential
-operation where the method fails, and says so in the memory), ``exhaustive-delay``
+operation where the method fails, and says so in the memory; on v1 the exact
+minimum pure delay, :mod:`.bracket`), ``exhaustive-delay``
 (minimum delay over the full map), ``sequential`` (robot 2 starts when robot 1
 ends), ``min-makespan`` (robot 2 pauses and resumes on a shortest monotone
 path, beyond the paper), ``undelayed`` (both start together: collides on the
