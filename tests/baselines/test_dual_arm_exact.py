@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
+from motiongym.agents.evaluate import run_episode
 from motiongym.agents.reproduce.dual_arm_truth import at_rest_pair
 from motiongym.baselines import make_policy
 from motiongym.baselines.dual_arm import bracket, schedules
@@ -135,15 +136,8 @@ def test_the_v1_policy_takes_the_exact_delay(truths, seed):
     t1, t2, free = truths[seed]
     env = gym.make(V1, control="robot_2")
     policy = make_policy(V1, "boundary-following", env.observation_space, env.action_space, KW)
-    obs, _ = env.reset(seed=seed - 20_000)
-    env.unwrapped.world.load(t1, t2)
-    obs = env.unwrapped.world.observation()
-    policy.reset()
-    done = False
-    while not done:
-        action, _ = policy.predict(obs)
-        obs, _, terminated, truncated, info = env.step(action)
-        done = terminated or truncated
+    info = run_episode(env, policy, seed)  # reset(seed) samples the same pair
+    np.testing.assert_array_equal(env.unwrapped.world.tasks[1].vias, t2.vias)
     d = policy.diagnostics()
     assert d["delay"] == int(np.flatnonzero(free)[0])
     assert d["replans"] == 0 and not d["fallback"]
