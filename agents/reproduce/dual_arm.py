@@ -346,8 +346,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
     _study_figure(out_dir, res)
     _print(case, res)
     truth = truth_study([SEED0 + i for i in range(3 if quick else TRUTH_PAIRS)])
-    seeds = [SEED0 + i for i in range(2 if quick else RESOLUTION_PAIRS)]
-    resolution = resolution_study(seeds, (50, 100) if quick else (50, 100, 200, 400))
+    resolution = resolution_study(truth, (50, 100) if quick else (50, 100, 200, 400))
     print_truth_study(truth, resolution)
     numbers = {
         "paper": PAPER,
@@ -360,8 +359,7 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
     return numbers
 
 
-TRUTH_PAIRS = 200  # pairs judged against the brute force (about 1.5 s a pair)
-RESOLUTION_PAIRS = 40  # pairs of the N_l study
+TRUTH_PAIRS = 200  # pairs judged against the brute force, and of the N_l study
 
 
 def _jsonable(value: Any) -> Any:

@@ -60,4 +60,4 @@ def test_truth_study(numbers):
         and "at rest" in truth["at_rest"]["end"]["reason"]
     )
     for n_levels in (50, 100):
-        assert numbers["resolution"][n_levels]["equal"] == 2
+        assert numbers["resolution"][n_levels]["equal"] == 3
