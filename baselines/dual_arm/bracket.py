@@ -68,6 +68,10 @@ def exact_delay_search(
     traj1: Trajectory, traj2: Trajectory, n_levels: int = 100, margin: float = 0.0
 ) -> DelayPlan:
     """The minimum collision-free pure delay of robot 2 (steps 1-3 above)."""
+    if isinstance(n_levels, bool) or not isinstance(n_levels, int | np.integer) or n_levels < 1:
+        raise ValueError(f"n_levels must be an integer >= 1, got {n_levels!r}")
+    if not np.isfinite(margin) or margin < 0:
+        raise ValueError(f"margin must be a finite number >= 0 m, got {margin!r}")
     check = StepCheck(traj1, traj2, margin)
     at_rest = check.at_rest_collides()
     if at_rest:

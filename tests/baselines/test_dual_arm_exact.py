@@ -151,3 +151,11 @@ def test_equal_to_the_brute_force_on_many_pairs():
         t1, t2 = _pair(seed)
         free = free_delays(step_table(t1, t2), t1.n_samples, t2.n_samples)
         assert bracket.exact_delay_search(t1, t2).delay == int(np.flatnonzero(free)[0]), seed
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"), [({"n_levels": 0}, "n_levels"), ({"margin": -1.0}, "margin")]
+)
+def test_bad_input_names_the_argument(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        bracket.exact_delay_search(*task.paper_case(), **kwargs)
