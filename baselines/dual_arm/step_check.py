@@ -181,7 +181,8 @@ class StepCheck:
         return bool(self.collides(rows, cols, first=True).any())
 
     def at_rest_collides(self) -> str:
-        """ "start" or "end" when the arms collide at rest there (no delay can help), else ""."""
+        """Where the arms collide at rest, at their start or end configurations (no
+        delay can help): "start", "end", or "" where they do not."""
         for name, (s1, s2) in (("start", (0, 0)), ("end", (self.n1, self.n2))):
             if self._distances(np.array([s1]), np.array([s2])).min() <= self.margin:
                 return name
