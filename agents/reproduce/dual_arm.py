@@ -14,6 +14,12 @@
    and the makespans of sequential, delay and minimum-makespan schedules.
    Each schedule's distance is re-evaluated exactly at every 20 ms sample of
    the motion (no map discretisation) to count collisions the map missed.
+3. The truth study (:mod:`.dual_arm_truth`, 200 pairs): boundary following on
+   each kind of map, and v1's exact search, against the brute force over
+   delays on ``DualArmCell-v1``'s check and a 20-instant grid per step
+   (equal / early / late by how much / failed, CPU time beside the brute
+   force's); the map resolution ``N_l`` in {50, 100, 200, 400} on the same
+   pairs; two pairs whose arms collide at rest.
 """
 
 from __future__ import annotations
@@ -25,7 +31,11 @@ from typing import Any
 
 import numpy as np
 
-from motiongym.agents.reproduce.dual_arm_truth import print_truth_study, truth_study
+from motiongym.agents.reproduce.dual_arm_truth import (
+    print_truth_study,
+    resolution_study,
+    truth_study,
+)
 from motiongym.baselines.dual_arm import schedules
 from motiongym.baselines.dual_arm.boundary_following import BoundaryResult, boundary_following
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
@@ -342,13 +352,20 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict[str, Any]:
     _study_figure(out_dir, res)
     _print(case, res)
     truth = truth_study([SEED0 + i for i in range(3 if quick else TRUTH_PAIRS)])
-    print_truth_study(truth)
-    numbers = {"paper": PAPER, "paper_case": case, "study": res, "truth": truth}
+    resolution = resolution_study(truth, (50, 100) if quick else (50, 100, 200, 400))
+    print_truth_study(truth, resolution)
+    numbers = {
+        "paper": PAPER,
+        "paper_case": case,
+        "study": res,
+        "truth": truth,
+        "resolution": resolution,
+    }
     (out_dir / "dual_arm.json").write_text(json.dumps(numbers, indent=2, default=_jsonable))
     return numbers
 
 
-TRUTH_PAIRS = 40  # pairs judged against the brute force (about 2.5 s a pair)
+TRUTH_PAIRS = 200  # pairs judged against the brute force, and of the N_l study
 
 
 def _jsonable(value: Any) -> Any:

@@ -22,12 +22,20 @@ PLANNERS: dict[str, tuple[str, float | None]] = {
         "motiongym.baselines.dual_arm.boundary_following:plan_paper_case",
         0.1,
     ),
-    "boundary following on the swept map (v1), dual-arm paper case": (
-        "motiongym.baselines.dual_arm.boundary_following:plan_paper_case_swept",
+    "boundary following + exact checks (v1), dual-arm paper case": (
+        "motiongym.baselines.dual_arm.bracket:plan_paper_case",
         0.1,
     ),
     "exact delay by brute force (v1 check), dual-arm paper case": (
         "motiongym.baselines.dual_arm.exact_delay:solve_paper_case",
+        None,
+    ),
+    "boundary following + exact checks (v1), per sampled pair (10 pairs in turn)": (
+        "motiongym.baselines.dual_arm.bracket:plan_sampled_pair",
+        0.1,
+    ),
+    "exact delay by brute force (v1 check), per sampled pair (the same pairs)": (
+        "motiongym.baselines.dual_arm.exact_delay:solve_sampled_pair",
         None,
     ),
 }

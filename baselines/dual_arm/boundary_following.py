@@ -206,10 +206,3 @@ def plan_paper_case() -> BoundaryResult:
     from motiongym.envs.dual_arm.task import paper_case
 
     return boundary_following(CollisionMap.from_tasks(*paper_case(), n_levels=100))
-
-
-def plan_paper_case_swept() -> BoundaryResult:
-    """:func:`plan_paper_case` on the swept map that the v1 policies plan on."""
-    from motiongym.envs.dual_arm.task import paper_case
-
-    return boundary_following(CollisionMap.from_tasks(*paper_case(), n_levels=100, swept=True))

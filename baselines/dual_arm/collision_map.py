@@ -10,6 +10,16 @@ cached; :attr:`CollisionMap.evaluated` counts the distinct cells computed
 ``s1 < 0``, ``s2 < 0`` and ``s2 > N_l`` are walls (blocked): robot 2 cannot
 run before its start or past its end.
 
+Three kinds of cells: the paper's (one configuration each: exact at no
+instant of the motion, so a delay may be early or late on the environment's
+check), the swept ones (any configuration of robot 1's step against any of
+robot 2's level interval: safe but late by 1-3 samples, since the two arms
+never take every pair of these configurations at once), and cells that are
+verdicts of ``DualArmCell-v1``'s own step check (:meth:`CollisionMap.from_steps`:
+an upper map, safe, and a lower map, never blocking a feasible delay; the
+v1 policy searches the lower one and checks its delay exactly,
+:mod:`.bracket`).
+
 TLVST (travelled length versus sampling time): ``tl[k] = floor(l(k dt) / dl)``,
 the level robot 2 has reached at its own sample ``k`` (``tl[N2] = N_l``). As a
 path of the paper's moves "0" (+s1) and "1" (+s2), the curve delayed by ``D``
@@ -27,6 +37,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from motiongym.baselines.dual_arm.step_check import StepCheck
 from motiongym.envs.dual_arm import model
 from motiongym.envs.dual_arm.motion import body_motion, configs, spans_collide, variation
 from motiongym.envs.dual_arm.task import DT, Trajectory
@@ -135,6 +146,57 @@ class CollisionMap:
             return out
 
         return cls(cells, n1, tl, n_levels)
+
+    @classmethod
+    def from_steps(
+        cls, check: StepCheck, traj2: Trajectory, n_levels: int = 100, bound: str = "lower"
+    ) -> CollisionMap:
+        """A map whose cells are verdicts of the environment's own step check.
+
+        A cell ``(s1, s2)`` lies on the curves of the delays whose step in column
+        ``s1`` has robot 2 in a state of ``K(s2)`` (the columns of
+        :class:`~.step_check.StepCheck`): waiting (``s2 = 0``), moving ``k`` with
+        ``tl[k] <= s2 <= tl[k + 1]``, or at rest (``s2 = N_l``); ``K(s2)`` is a
+        contiguous range. Robot 1 is on its step ``min(s1, N1)`` (the last
+        column, ``s1 = max(N1, D + N2)``, is both at rest: its verdict is the end
+        configuration's, which the delay's last step ends in).
+
+        * ``bound="upper"``: blocked iff *some* step of ``K(s2)`` collides (exact
+          verdicts). **Every delay free on this map is free on the environment's
+          check**: step ``x`` of delay ``D`` has robot 2 in a state ``c`` that
+          belongs to ``K(s2)`` of a cell of ``D``'s curve in column ``x``
+          (waiting: ``(x, 0)``; moving ``k``: ``(x, tl[k])``; at rest:
+          ``(x, N_l)``); that cell is free, so step ``(x, c)`` is clear.
+        * ``bound="lower"``: blocked iff *every* step of ``K(s2)`` certainly
+          collides (an end configuration within the margin: the screen alone).
+          **Every delay free on the environment's check is free on this map**:
+          a cell ``(x, s2)`` of delay ``D``'s curve belongs to ``D``'s step ``x``
+          with robot 2 in a state of ``K(s2)`` (the last column: the end
+          configuration, which ``D``'s last step ends in); were the cell blocked,
+          that step would collide. So the map's minimum delay is a lower bound
+          on the true one.
+        """
+        if bound not in ("lower", "upper"):
+            raise ValueError(f"bound must be 'lower' or 'upper', got {bound!r}")
+        _, tl, _ = traj2.length_parametrised(n_levels)
+        n2 = len(tl) - 1
+        levels = np.arange(n_levels + 1)
+        c_lo = np.searchsorted(tl[1:], levels, side="left") + 1  # first k with tl[k+1] >= s2
+        c_hi = np.searchsorted(tl[:-1], levels, side="right")  # last k with tl[k] <= s2, + 1
+        c_lo[0], c_hi[-1] = 0, n2 + 1  # waiting at level 0, at rest at N_l
+
+        def cells(s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
+            out = np.empty(len(s1), dtype=bool)
+            for i, (row, level) in enumerate(zip(s1.tolist(), s2.tolist(), strict=True)):
+                cols = np.arange(c_lo[level], c_hi[level] + 1)
+                rows = np.full(len(cols), row)
+                if bound == "lower":
+                    out[i] = bool(check.certainly(rows, cols).all())
+                else:
+                    out[i] = bool(check.collides(rows, cols, first=True).any())
+            return out
+
+        return cls(cells, check.n1, tl, n_levels)
 
     @classmethod
     def from_array(cls, occupied: np.ndarray, tlvst: np.ndarray) -> CollisionMap:

@@ -14,38 +14,26 @@ calls that step a collision by
 of delay ``D`` depends only on ``(s1, k) = (t - 1, t - 1 - D)``: the table of
 every ``(s1, k)`` decides every delay at once, and ``D`` is collision free iff
 its diagonal ``k = s1 - D`` is free for ``s1 = 0 .. max(N1, D + N2) - 1``.
-The table uses the environment's own check and nothing of the collision map.
+The table uses the environment's own check (:mod:`.step_check`, every entry
+decided) and nothing of the collision maps or of boundary following.
 """
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
-from motiongym.envs.dual_arm import model, motion
+from motiongym.baselines.dual_arm.step_check import StepCheck
 from motiongym.envs.dual_arm.task import Trajectory
 
 
 def step_table(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> np.ndarray:
     """(N1 + 1, N2 + 2) bool: does the step with robot 1 on ``[s1, s1 + 1]`` and robot 2 on
     ``[k, k + 1]`` collide? Column ``0`` is robot 2 waiting at its start (``k < 0``); column
-    ``k + 1`` its move ``k`` (``k = N2``: at rest at its end); row ``N1``: robot 1 at rest."""
-    q1, q2 = traj1.samples(), traj2.samples()
-    n1, n2 = len(q1) - 1, len(q2) - 1
-    a1 = np.minimum(np.arange(n1 + 1), n1)
-    b1 = np.minimum(a1 + 1, n1)
-    a2 = np.concatenate([[0], np.minimum(np.arange(n2 + 1), n2)])
-    b2 = np.concatenate([[0], np.minimum(np.arange(n2 + 1) + 1, n2)])
-    d_start = model.pair_distances(q1[a1][:, None], q2[a2][None, :])  # (R, C, 5, 5)
-    d_end = model.pair_distances(q1[b1][:, None], q2[b2][None, :])
-    m1 = motion.body_motion(np.abs(q1[b1] - q1[a1]))  # (R, 5)
-    m2 = motion.body_motion(np.abs(q2[b2] - q2[a2]))  # (C, 5)
-    slack = m1[:, None, :, None] / 2 + m2[None, :, None, :] / 2
-    low = np.minimum((d_start - slack).min(axis=(-2, -1)), (d_end - slack).min(axis=(-2, -1)))
-    hit = (d_end.min(axis=(-2, -1)) <= margin) | (d_start.min(axis=(-2, -1)) <= margin)
-    table = hit.copy()
-    for r, c in np.argwhere(~hit & (low <= margin)):
-        table[r, c] = motion.simultaneous_collide(q1, (a1[r], b1[r]), q2, (a2[c], b2[c]), margin)
-    return table
+    ``k + 1`` its move ``k`` (``k = N2``: at rest at its end); row ``N1``: robot 1 at rest.
+    Every entry of :class:`.step_check.StepCheck`, each decided."""
+    return StepCheck(traj1, traj2, margin).table()
 
 
 def free_delays(table: np.ndarray, n1: int, n2: int) -> np.ndarray:
@@ -73,3 +61,15 @@ def solve_paper_case() -> int | None:
     from motiongym.envs.dual_arm.task import paper_case
 
     return true_min_delay(*paper_case())
+
+
+_turn = itertools.count()
+
+
+def solve_sampled_pair() -> int | None:
+    """The brute force on the next of the pairs that ``bracket.plan_sampled_pair`` times
+    (a benchmark hook, in the same turn order)."""
+    from motiongym.baselines.dual_arm.bracket import bench_pairs
+
+    pairs = bench_pairs()
+    return true_min_delay(*pairs[next(_turn) % len(pairs)])

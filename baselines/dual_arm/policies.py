@@ -10,7 +10,8 @@ robot 2 the schedule's 0 or 1. Works for ``control="both"`` (action (2,)) and
 ``control="robot_2"`` (action (1,)).
 
 Policies: ``boundary-following`` (the paper; falls back to sequential
-operation where the method fails, and says so in the memory), ``exhaustive-delay``
+operation where the method fails, and says so in the memory; on v1 the exact
+minimum pure delay, :mod:`.bracket`), ``exhaustive-delay``
 (minimum delay over the full map), ``sequential`` (robot 2 starts when robot 1
 ends), ``min-makespan`` (robot 2 pauses and resumes on a shortest monotone
 path, beyond the paper), ``undelayed`` (both start together: collides on the
@@ -26,6 +27,7 @@ from gymnasium import spaces
 
 from motiongym.baselines.dual_arm import exact_delay, schedules
 from motiongym.baselines.dual_arm.boundary_following import boundary_following
+from motiongym.baselines.dual_arm.bracket import exact_delay_search
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.envs.core import params_from_kwargs
@@ -45,7 +47,9 @@ class SchedulePolicy(ScriptedPolicy):
             (``schedules.collides_at_samples``); where the map's length
             discretisation hid a graze, plan again with the map's margin raised
             by ``replan_step`` (m), at most ``max_replans`` times, then fall back
-            to sequential operation. The memory records ``margin`` and ``replans``.
+            to sequential operation (v1: to the exact minimum pure delay). The
+            memory records ``margin`` and ``replans`` (the guard's firings); a
+            plan that says no pure delay exists (``reason``) is not re-planned.
     """
 
     def __init__(
@@ -84,9 +88,12 @@ class SchedulePolicy(ScriptedPolicy):
         margin = self.margin
         for replans in range(self.max_replans + 1):
             cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, margin, self.swept)
+            memory.update(margin=margin)
             plan = self.plan(cmap, memory)
-            memory.update(map=cmap, margin=margin, replans=replans)
+            memory.update(map=cmap, replans=replans)
             collides = schedules.collides_swept if self.swept else schedules.collides_at_samples
+            if memory.get("reason"):  # no pure delay exists: nothing to re-plan
+                return plan
             if not (self.verify and self.verifiable) or not collides(
                 traj1, traj2, plan.advances, self.safety_margin
             ):
@@ -107,13 +114,15 @@ class SchedulePolicy(ScriptedPolicy):
 
     def describe(self, memory: dict[str, Any]) -> dict[str, Any]:
         """``delay`` (samples, None for a schedule that is not a pure delay), ``replans``
-        (how often the verification raised the map's margin), ``fallback`` (the plan
-        did not come from the policy's own method)."""
+        (how often the verification raised the map's margin: the guard's firings),
+        ``fallback`` (the plan did not come from the policy's own method),
+        ``reason`` (why the policy's method found no delay, "" otherwise)."""
         plan = memory.get("schedule")
         return {
             "delay": None if plan is None else plan.delay,
             "replans": memory.get("replans", 0),
             "fallback": bool(memory.get("fallback", False)),
+            "reason": memory.get("reason", ""),
         }
 
     def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
@@ -130,9 +139,22 @@ class SchedulePolicy(ScriptedPolicy):
 
 
 class BoundaryFollowingPolicy(SchedulePolicy):
-    """The paper's minimum start delay by boundary following (section III)."""
+    """The paper's minimum start delay by boundary following (section III).
+
+    On v0 on the paper's map. On v1 boundary following runs on a map of the
+    environment's own step check and its delay is then made exact
+    (:func:`.bracket.exact_delay_search`): the minimum pure delay on v1's
+    check; where none exists (``reason`` in the memory: e.g. the arms collide
+    at rest) robot 2 starts when robot 1 ends, reported as a fallback.
+    """
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
+        if self.swept:
+            found = exact_delay_search(*memory["tasks"], self.n_levels, memory["margin"])
+            memory.update(result=found, fallback=found.delay is None, reason=found.reason)
+            if found.delay is None:
+                return schedules.sequential(cmap)
+            return schedules.delay_schedule(cmap, found.delay)
         result = boundary_following(cmap)
         memory["result"] = result
         memory["fallback"] = result.delay is None

@@ -113,26 +113,40 @@ Box = tuple[float, float, float, float]  # robot 1's span, robot 2's span (fract
 
 
 def _halving(
-    samples1: np.ndarray, samples2: np.ndarray, box: Box, margin: float, resolution: float, split
-) -> bool:
-    """Bound, then halve (``split``) every box the bound cannot clear, until decided."""
-    todo = [box]
+    samples1: np.ndarray,
+    samples2: np.ndarray,
+    boxes: list[Box],
+    margin: float,
+    resolution: float,
+    split,
+) -> np.ndarray:
+    """Bound, then halve (``split``) every box the bound cannot clear, until decided.
+
+    One verdict per given box, (n,) bool; the halves of box ``i`` answer for
+    ``i`` (a box is decided colliding by any of its pieces, clear by all).
+    """
+    out = np.zeros(len(boxes), dtype=bool)
+    todo = [(i, box) for i, box in enumerate(boxes)]
     while todo:
-        b = np.array(todo)  # (n, 4)
+        owner = np.array([i for i, _ in todo])
+        b = np.array([box for _, box in todo])  # (n, 4)
         q1 = configs(samples1, b[:, :2].mean(axis=1))
         q2 = configs(samples2, b[:, 2:].mean(axis=1))
         d = model.pair_distances(q1, q2)  # (n, 5, 5)
-        if (d.min(axis=(-2, -1)) <= margin).any():
-            return True
+        out[owner[d.min(axis=(-2, -1)) <= margin]] = True
         m1 = body_motion(variation(samples1, b[:, 0], b[:, 1]))
         m2 = body_motion(variation(samples2, b[:, 2], b[:, 3]))
         todo = []
         for i in np.flatnonzero(_lower_bound(d, m1, m2) <= margin):
+            if out[owner[i]]:
+                continue  # decided
             w1, w2 = m1[i].max(), m2[i].max()
             if (w1 + w2) / 2 < resolution:
-                return True  # within resolution of the margin: conservative
-            todo += split(*b[i], w1, w2)
-    return False
+                out[owner[i]] = True  # within resolution of the margin: conservative
+                continue
+            todo += [(owner[i], half) for half in split(*b[i], w1, w2)]
+        todo = [(i, box) for i, box in todo if not out[i]]
+    return out
 
 
 def _together(lo1: float, hi1: float, lo2: float, hi2: float, w1: float, w2: float) -> list:
@@ -161,7 +175,22 @@ def simultaneous_collide(
     Robot r moves uniformly over ``span_r`` as time runs through the step (both
     together, as in one environment step): the two spans are halved together.
     """
-    return _halving(samples1, samples2, (*span1, *span2), margin, resolution, _together)
+    return bool(_halving(samples1, samples2, [(*span1, *span2)], margin, resolution, _together)[0])
+
+
+def simultaneous_collide_many(
+    samples1: np.ndarray,
+    spans1: np.ndarray,
+    samples2: np.ndarray,
+    spans2: np.ndarray,
+    margin: float,
+    resolution: float = RESOLUTION,
+) -> np.ndarray:
+    """:func:`simultaneous_collide` of many steps at once: spans (n, 2) each -> (n,) bool,
+    the same verdicts (each step's boxes are halved as alone), one bound per level."""
+    boxes = [(*a, *b) for a, b in zip(np.asarray(spans1, float).tolist(),
+                                      np.asarray(spans2, float).tolist(), strict=True)]  # fmt: skip
+    return _halving(samples1, samples2, boxes, margin, resolution, _together)
 
 
 def spans_collide(
@@ -175,4 +204,4 @@ def spans_collide(
     """Does any configuration of robot 1 over ``span1`` come within ``margin`` of any
     configuration of robot 2 over ``span2`` (each a span of fractional samples)?
     The span whose bodies move farther is halved first."""
-    return _halving(samples1, samples2, (*span1, *span2), margin, resolution, _longer)
+    return bool(_halving(samples1, samples2, [(*span1, *span2)], margin, resolution, _longer)[0])

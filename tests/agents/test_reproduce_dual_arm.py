@@ -48,3 +48,16 @@ def test_outputs_written(numbers):
         assert (out / name).stat().st_size > 10_000
     saved = json.loads((out / "dual_arm.json").read_text())
     assert saved["paper"]["delay_s"] == 0.7
+
+
+def test_truth_study(numbers):
+    truth = numbers["truth"]
+    assert truth["pairs"] == 3
+    assert truth["exact"]["equal"] == 3 and truth["exact_fine_collisions"] == 0
+    assert truth["exact"]["early"] == truth["exact"]["failed"] == 0
+    assert (
+        truth["at_rest"]["start"]["delay"] is None
+        and "at rest" in truth["at_rest"]["end"]["reason"]
+    )
+    for n_levels in (50, 100):
+        assert numbers["resolution"][n_levels]["equal"] == 3
