@@ -111,7 +111,9 @@ class DualArmCellEnv(Renders, gym.Env):
 
     * v1: ``collision_check="swept"``: collisions between control samples
       count (an undelayed pair that grazed between two 20 ms samples passed
-      v0's check).
+      v0's check); a "colliding" pair also runs one after the other without
+      contact in motion (:func:`.task.sequential_clear_in_motion`), so a
+      start delay always exists on v1's check.
     * v0: first version (collision checked at the control samples only).
     """
 
@@ -179,7 +181,9 @@ class DualArmCellEnv(Renders, gym.Env):
         super().reset(seed=seed)
         options = check_options(options, {"task": partial(check_choice, choices=TASK_MODES)})
         mode = options.get("task", self.task)
-        self.world.load(*task_module.sample_pair(self.np_random, mode, self.safety_margin))
+        swept = self.collision_check == "swept"
+        pair = task_module.sample_pair(self.np_random, mode, self.safety_margin, in_motion=swept)
+        self.world.load(*pair)
         self._wait2 = 0.0
         info = self._info(collided=False, terms={k: 0.0 for k in self.weights})
         self._show_if_human()

@@ -162,3 +162,16 @@ def test_pettingzoo_state_test_passes():
     from motiongym.envs.dual_arm import parallel_env
 
     state_test(parallel_to_aec(parallel_env()), parallel_env())
+
+
+def test_v1_colliding_pairs_run_one_after_the_other_without_contact_in_motion():
+    # seed 50167: clear one after the other at the samples, not in motion (robot 2's
+    # path grazes robot 1's end between two samples); v1's sampler draws on past it
+    from motiongym.envs.dual_arm import task
+
+    rng = np.random.default_rng(50167)
+    t1, t2 = task.sample_pair(rng, "colliding")
+    assert task.sequential_clear(t1, t2) and not task.sequential_clear_in_motion(t1, t2)
+    u1, u2 = task.sample_pair(np.random.default_rng(50167), "colliding", in_motion=True)
+    assert task.sequential_clear_in_motion(u1, u2)
+    assert u1.duration != t1.duration or not np.array_equal(u1.vias, t1.vias)
