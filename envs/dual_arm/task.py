@@ -25,7 +25,7 @@ robot 1's end), so a finite start delay always exists; ``"paper"``: the fixed
 paper case (:func:`paper_case`), colliding undelayed over an interval like the
 paper's 0.76-1.16 s. Every test is exact at every 20 ms sample; the geometry
 of both arms' samples and the collision tests run in few NumPy operations
-(:mod:`.sweep`), since this runs on every reset. The draws are those of
+(:mod:`.capsule_paths`), since this runs on every reset. The draws are those of
 drawing robot 1 until accepted, then robot 2 (:func:`_sample_arms`), so a
 seed's tasks do not depend on how the geometry is computed.
 
@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motiongym.envs.dual_arm import model, motion, sweep
+from motiongym.envs.dual_arm import capsule_paths, model, motion
 
 DT = 0.02  # s, controller sample time (paper)
 N_VIAS = 4
@@ -176,11 +176,11 @@ def _draw_arm(rng: np.random.Generator, robot: int) -> Trajectory:
     return Trajectory(vias, dur, robot)
 
 
-def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, sweep.Sweep]:
+def _sample_arm(rng: np.random.Generator, robot: int) -> tuple[Trajectory, capsule_paths.Sweep]:
     """Draws until the gripper tip stays above ``MIN_TOOL_Z``."""
     while True:
         traj = _draw_arm(rng, robot)
-        swept = sweep.Sweep.of(traj.samples(), robot)
+        swept = capsule_paths.Sweep.of(traj.samples(), robot)
         if swept.tip_z.min() >= MIN_TOOL_Z:
             return traj, swept
 
@@ -194,7 +194,7 @@ def _sample_arms(rng: np.random.Generator) -> tuple[tuple, tuple]:
     traj1 = _draw_arm(rng, 0)
     after1 = rng.bit_generator.state
     traj2 = _draw_arm(rng, 1)
-    swept1, swept2 = sweep.Sweep.of_pair(traj1.samples(), traj2.samples())
+    swept1, swept2 = capsule_paths.Sweep.of_pair(traj1.samples(), traj2.samples())
     if swept1.tip_z.min() < MIN_TOOL_Z:
         rng.bit_generator.state = after1
         return _sample_arm(rng, 0), _sample_arm(rng, 1)
@@ -203,16 +203,21 @@ def _sample_arms(rng: np.random.Generator) -> tuple[tuple, tuple]:
     return (traj1, swept1), (traj2, swept2)
 
 
-def _check_pair(swept1: sweep.Sweep, swept2: sweep.Sweep, margin: float) -> tuple[bool, bool]:
+def _check_pair(
+    swept1: capsule_paths.Sweep, swept2: capsule_paths.Sweep, margin: float
+) -> tuple[bool, bool]:
     """(collides when both start together, one after the other is collision free).
 
     One after the other: robot 1's whole path clears robot 2's start and robot
     2's whole path clears robot 1's end. Both from one exact test over the
-    instants of both schedules (:func:`.sweep.schedules_collide`).
+    instants of both schedules (:func:`.capsule_paths.schedules_collide`).
     """
     n1, n2 = swept1.n_samples, swept2.n_samples
-    together, sequential = sweep.schedules_collide(
-        swept1, swept2, [sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)], margin
+    together, sequential = capsule_paths.schedules_collide(
+        swept1,
+        swept2,
+        [capsule_paths.together_rows(n1, n2), capsule_paths.sequential_rows(n1, n2)],
+        margin,
     )
     return together, not sequential
 
@@ -226,9 +231,9 @@ def undelayed_distance(traj1: Trajectory, traj2: Trajectory) -> np.ndarray:
 
 def sequential_clear(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> bool:
     """Robot 1's path clears robot 2's start and robot 2's path clears robot 1's end."""
-    s1, s2 = (sweep.Sweep.of(t.samples(), t.robot) for t in (traj1, traj2))
-    rows1, rows2 = sweep.sequential_rows(traj1.n_samples, traj2.n_samples)
-    return not sweep.colliding_instants(s1, rows1, s2, rows2, margin).any()
+    s1, s2 = (capsule_paths.Sweep.of(t.samples(), t.robot) for t in (traj1, traj2))
+    rows1, rows2 = capsule_paths.sequential_rows(traj1.n_samples, traj2.n_samples)
+    return not capsule_paths.colliding_instants(s1, rows1, s2, rows2, margin).any()
 
 
 def sequential_clear_in_motion(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> bool:

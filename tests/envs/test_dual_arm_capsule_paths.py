@@ -7,7 +7,7 @@ import hashlib
 import numpy as np
 import pytest
 
-from motiongym.envs.dual_arm import model, sweep, task
+from motiongym.envs.dual_arm import capsule_paths, model, task
 
 # sha256 over seeds 0..49 of sample_pair(default_rng(seed), mode, margin): both
 # tasks' compact forms, then the generator's next random() (so the number of
@@ -41,18 +41,20 @@ def test_first_seed_tasks_by_value():
 @pytest.mark.parametrize("robot", [0, 1])
 def test_capsule_points_equal_the_frames(robot):
     q = np.random.default_rng(robot).uniform(-3.0, 3.0, (300, 6))
-    a, b = sweep.capsule_points(q, robot)
+    a, b = capsule_paths.capsule_points(q, robot)
     a_ref, b_ref = model.link_segments(q, model.base_transform(robot))
     np.testing.assert_allclose(a, a_ref, atol=1e-12)
     np.testing.assert_allclose(b, b_ref, atol=1e-12)
     tip = task.tool_tip_z(model.body_frames(q, model.base_transform(robot)))
-    np.testing.assert_allclose(sweep.Sweep.of(q, robot).tip_z, tip, atol=1e-12)
+    np.testing.assert_allclose(capsule_paths.Sweep.of(q, robot).tip_z, tip, atol=1e-12)
     # Leading axes as model.link_segments: none, or several.
-    assert sweep.capsule_points(q[0], robot)[0].shape == (5, 3)
-    assert sweep.capsule_points(q.reshape(3, 100, 6), robot)[1].shape == (3, 100, 5, 3)
+    assert capsule_paths.capsule_points(q[0], robot)[0].shape == (5, 3)
+    assert capsule_paths.capsule_points(q.reshape(3, 100, 6), robot)[1].shape == (3, 100, 5, 3)
 
 
-def _exact_hits(s1: sweep.Sweep, rows1, s2: sweep.Sweep, rows2, margin: float) -> np.ndarray:
+def _exact_hits(
+    s1: capsule_paths.Sweep, rows1, s2: capsule_paths.Sweep, rows2, margin: float
+) -> np.ndarray:
     (a1, b1), (a2, b2) = s1.segments(), s2.segments()
     d = model.segment_pair_distances(a1[rows1], b1[rows1], a2[rows2], b2[rows2])
     return d.min(axis=(-2, -1)) <= margin
@@ -63,14 +65,16 @@ def test_colliding_instants_is_exact():
     for _ in range(25):
         (t1, s1), (t2, s2) = task._sample_arm(rng, 0), task._sample_arm(rng, 1)
         n1, n2 = t1.n_samples, t2.n_samples
-        schedules = [sweep.together_rows(n1, n2), sweep.sequential_rows(n1, n2)]
+        schedules = [capsule_paths.together_rows(n1, n2), capsule_paths.sequential_rows(n1, n2)]
         for margin in (-0.02, 0.0, 0.05, 0.3):
             exact = [_exact_hits(s1, r1, s2, r2, margin) for r1, r2 in schedules]
             for (rows1, rows2), hits in zip(schedules, exact, strict=True):
                 np.testing.assert_array_equal(
-                    sweep.colliding_instants(s1, rows1, s2, rows2, margin), hits
+                    capsule_paths.colliding_instants(s1, rows1, s2, rows2, margin), hits
                 )
-            assert sweep.schedules_collide(s1, s2, schedules, margin) == [h.any() for h in exact]
+            assert capsule_paths.schedules_collide(s1, s2, schedules, margin) == [
+                h.any() for h in exact
+            ]
 
 
 def test_colliding_instants_at_the_margin():
@@ -78,16 +82,16 @@ def test_colliding_instants_at_the_margin():
     # instant; a hair below it, none: the broad phase never drops the closest pair.
     rng = np.random.default_rng(5)
     (t1, s1), (t2, s2) = task._sample_arm(rng, 0), task._sample_arm(rng, 1)
-    rows1, rows2 = sweep.together_rows(t1.n_samples, t2.n_samples)
+    rows1, rows2 = capsule_paths.together_rows(t1.n_samples, t2.n_samples)
     (a1, b1), (a2, b2) = s1.segments(), s2.segments()
     d = model.segment_pair_distances(a1[rows1], b1[rows1], a2[rows2], b2[rows2]).min(axis=(1, 2))
     k = int(np.argmin(d))
-    hits = sweep.colliding_instants(s1, rows1, s2, rows2, float(d[k]))
+    hits = capsule_paths.colliding_instants(s1, rows1, s2, rows2, float(d[k]))
     assert hits[k] and hits.sum() == np.sum(d <= d[k])
-    assert not sweep.colliding_instants(s1, rows1, s2, rows2, float(d[k]) - 1e-7).any()
+    assert not capsule_paths.colliding_instants(s1, rows1, s2, rows2, float(d[k]) - 1e-7).any()
     schedule = [(rows1, rows2)]
-    assert sweep.schedules_collide(s1, s2, schedule, float(d[k])) == [True]
-    assert sweep.schedules_collide(s1, s2, schedule, float(d[k]) - 1e-7) == [False]
+    assert capsule_paths.schedules_collide(s1, s2, schedule, float(d[k])) == [True]
+    assert capsule_paths.schedules_collide(s1, s2, schedule, float(d[k]) - 1e-7) == [False]
 
 
 def test_pair_checks_match_their_definitions():
