@@ -51,8 +51,10 @@ TRACKS = ((-2.25, 2.25), (-1.5, 1.5), (0.0, 0.92))  # x, y, z (m, frame M)
 # The boom is not checked against the tracks: the straight pin-to-pin line of
 # a bent boom passes where the real boom does not (within the joint limits,
 # the boom's underside meets the ground first, which stops it).
+PART_NAMES = ("boom", "stick", "bucket", "house", "tracks")
 SELF_PAIRS = (("bucket", "tracks"), ("bucket", "house"), ("stick", "tracks"), ("stick", "house"))
 
+SKIP = 1e-9  # m: a lower bound this far above the distance of interest rules a body out
 Vec = tuple[float, float, float]
 
 
@@ -87,11 +89,18 @@ class Box:
 
     def gap(self, p) -> float:
         """Distance from the point ``p`` to the box (0 inside)."""
+        c, (a, b, e), (hx, hy, hz) = self.centre, self.axes, self.half
+        x, y, z = p[0] - c[0], p[1] - c[1], p[2] - c[2]
         total = 0.0
-        for x, h in zip(self.local(p), self.half, strict=True):
-            g = abs(x) - h
-            if g > 0.0:
-                total += g * g
+        g = abs(a[0] * x + a[1] * y + a[2] * z) - hx
+        if g > 0.0:
+            total += g * g
+        g = abs(b[0] * x + b[1] * y + b[2] * z) - hy
+        if g > 0.0:
+            total += g * g
+        g = abs(e[0] * x + e[1] * y + e[2] * z) - hz
+        if g > 0.0:
+            total += g * g
         return math.sqrt(total)
 
     def world(self, u: float, v: float, w: float) -> Vec:
@@ -121,15 +130,38 @@ class Box:
 
 def box_from_ranges(origin: Vec, axes, ranges) -> Box:
     """The box spanning ``ranges`` ((lo, hi) per axis) along ``axes`` from ``origin``."""
-    mid = [0.5 * (lo + hi) for lo, hi in ranges]
-    centre = tuple(origin[i] + sum(mid[k] * axes[k][i] for k in range(3)) for i in range(3))
-    return Box(centre, tuple(tuple(a) for a in axes), tuple(0.5 * (hi - lo) for lo, hi in ranges))
+    (l0, h0), (l1, h1), (l2, h2) = ranges
+    m0, m1, m2 = 0.5 * (l0 + h0), 0.5 * (l1 + h1), 0.5 * (l2 + h2)
+    a, b, c = axes
+    centre = tuple(
+        origin[i] + sum((m0 * a[i], m1 * b[i], m2 * c[i])) for i in range(3)
+    )  # sum() as the reference: the same rounding on every Python
+    half = (0.5 * (h0 - l0), 0.5 * (h1 - l1), 0.5 * (h2 - l2))
+    return Box(centre, (tuple(a), tuple(b), tuple(c)), half)
 
 
-def segment_to_box(a, b, box: Box) -> float:
-    """Distance from the segment ``a b`` to ``box`` (0 when they meet)."""
-    low = tuple(-h for h in box.half)
-    return segment_box_distance(box.local(a), box.local(b), low, box.half)
+def segment_to_box(a, b, box: Box, above: float = math.inf) -> float:
+    """Distance from the segment ``a b`` to ``box`` (0 when they meet).
+
+    First a lower bound: the gap between the segment's bounding box and the
+    box, in the box's frame (per axis, every point of the segment is at least
+    that far from the box's slab). When it is ``SKIP`` or more above
+    ``above``, the bound is returned instead of the distance.
+    """
+    la, lb = box.local(a), box.local(b)
+    hx, hy, hz = box.half
+    if above < math.inf:
+        total = 0.0
+        for p, q, h in ((la[0], lb[0], hx), (la[1], lb[1], hy), (la[2], lb[2], hz)):
+            g = (p if p < q else q) - h
+            if g <= 0.0:
+                g = -h - (q if p < q else p)
+            if g > 0.0:
+                total += g * g
+        bound = math.sqrt(total)
+        if bound - above >= SKIP:
+            return bound
+    return segment_box_distance(la, lb, (-hx, -hy, -hz), box.half)
 
 
 def separation(p: Box, q: Box) -> float:
@@ -213,22 +245,38 @@ def machine_bodies(
     ``names`` (default: all five) selects the parts built.
     """
     foot, stick_pin, pin, tip = points
+    rot = _apply(rotation)
+    axis, up = swing_axis(rotation, L0)
+    out = {}
+    for name in names or PART_NAMES:
+        if name == "boom":
+            out[name] = Capsule(foot, stick_pin, BOOM_RADIUS)
+        elif name == "stick":
+            out[name] = Capsule(stick_pin, pin, STICK_RADIUS)
+        elif name == "bucket":  # the lateral axis is the joint axis z = (s1, -c1, 0)
+            lateral = rot((math.sin(swing), -math.cos(swing), 0.0))
+            out[name] = bucket_box(pin, tip, lateral, bucket_width)
+        elif name == "house":
+            out[name] = house_box(axis, up, swing, rotation)
+        else:
+            out[name] = box_from_ranges(
+                axis, (rot((1.0, 0.0, 0.0)), rot((0.0, 1.0, 0.0)), up), TRACKS
+            )
+    return out
+
+
+def swing_axis(rotation, L0: float) -> tuple[Vec, Vec]:
+    """Where the swing axis meets the ground (``x = -L0`` in M) and the base's z, in frame O."""
+    rot = _apply(rotation)
+    return rot((-L0, 0.0, 0.0)), rot((0.0, 0.0, 1.0))
+
+
+def house_box(axis: Vec, up: Vec, swing: float, rotation) -> Box:
+    """The house's body at the swing angle; ``axis`` (where the swing axis meets the
+    ground) and ``up`` (the base's z) in frame O, ``rotation`` as in :func:`machine_bodies`."""
     c1, s1 = math.cos(swing), math.sin(swing)
     rot = _apply(rotation)
-    up, axis = rot((0.0, 0.0, 1.0)), rot((-L0, 0.0, 0.0))  # where the swing axis meets the ground
-    build = {
-        "boom": lambda: Capsule(foot, stick_pin, BOOM_RADIUS),
-        "stick": lambda: Capsule(stick_pin, pin, STICK_RADIUS),
-        # The bucket's lateral axis is the joint axis z = (s1, -c1, 0).
-        "bucket": lambda: bucket_box(pin, tip, rot((s1, -c1, 0.0)), bucket_width),
-        "house": lambda: box_from_ranges(
-            axis, (rot((c1, s1, 0.0)), rot((-s1, c1, 0.0)), up), HOUSE
-        ),
-        "tracks": lambda: box_from_ranges(
-            axis, (rot((1.0, 0.0, 0.0)), rot((0.0, 1.0, 0.0)), up), TRACKS
-        ),
-    }
-    return {name: build[name]() for name in (names or build)}
+    return box_from_ranges(axis, (rot((c1, s1, 0.0)), rot((-s1, c1, 0.0)), up), HOUSE)
 
 
 def _apply(rotation):

@@ -54,6 +54,8 @@ HOUSE_RADIUS = 3.5  # m: house and tracks lie within this of the swing axis (3.1
 # The bucket shell's underside in the bucket frame: (fraction of L4 along u, m behind the opening).
 SHELL = ((0.0, 0.75), (0.6, 0.9), (0.85, 0.55))
 SHELL_INSET = 0.1  # m: shell points this far inside the side plates (one cell of the map)
+REACH = (bodies.BOOM_RADIUS, bodies.STICK_RADIUS, UNDER_REACH)  # each part's from its segment
+SKIP = bodies.SKIP  # m: a bound this far above the smallest clearance so far leaves its part out
 
 
 class Pose:
@@ -75,10 +77,14 @@ class Pose:
         "low_arm",
         "low_edge",
         "_world",
+        "edge_memo",
+        "body_memo",
     )
 
     def __init__(self, q, world) -> None:
         self.q, self._world = q, world
+        # (terrain, its version, depth): the exact depths below, kept while the ground stays.
+        self.edge_memo = self.body_memo = (None, -1, 0.0)
         m, r = world.m, world.rotation
         q1, q2, q3, q4 = q
         pts = arm_points(q1, q2, q3, q4, m)
@@ -88,17 +94,14 @@ class Pose:
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
         if r is not None:
             (a, b, c), (d, e, f), (g, h, i) = r
-            pts, n, u, lat = (
-                tuple(
-                    (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-                    for x, y, z in vectors
-                )
-                for vectors in (pts, (n,), (u,), (lat,))
-            )
-            n, u, lat = n[0], u[0], lat[0]
+            p0, p1, p2, p3, n, u, lat = [
+                (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+                for x, y, z in (*pts, n, u, lat)
+            ]
+            pts = (p0, p1, p2, p3)
         self.points, self.tip, self.beta = pts, pts[3], beta
         self.n, self.u, self.lat = n, u, lat
-        tip, half = pts[3], 0.5 * m.bucket_width - 0.05
+        tip, half = pts[3], world._edge_half
         lx, ly, lz = half * lat[0], half * lat[1], half * lat[2]
         self.edge = (
             (tip[0] + lx, tip[1] + ly, tip[2] + lz),
@@ -107,7 +110,10 @@ class Pose:
         )
         # Heights above the ground plane: of the lowest arm point past the foot, and the edge.
         gx, gy = world._gx, world._gy
-        self.low_arm = min(p[2] - gx * p[0] - gy * p[1] for p in pts[1:])
+        _, (x1, y1, z1), (x2, y2, z2), (x3, y3, z3) = pts
+        h1, h2, h3 = z1 - gx * x1 - gy * y1, z2 - gx * x2 - gy * y2, z3 - gx * x3 - gy * y3
+        low = h2 if h2 < h1 else h1
+        self.low_arm = h3 if h3 < low else low
         self.low_edge = tip[2] - gx * tip[0] - gy * tip[1] - abs(lz) - abs(gx * lx + gy * ly)
 
     def under(self) -> list[tuple[float, float, float]]:
@@ -157,6 +163,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._truck_centre = (truck.cx, truck.cy)
         self._truck_radius = math.hypot(truck.half_length, truck.half_width)
         self._axis = (-self.m.L0, 0.0)
+        self._edge_half = 0.5 * self.m.bucket_width - 0.05  # the edge's half-width past the plates
         # The house stays within HOUSE_RADIUS of the axis: its bound to the truck is fixed.
         self._house_truck = (
             math.hypot(truck.cx + self.m.L0, truck.cy) - self._truck_radius - HOUSE_RADIUS
@@ -182,6 +189,17 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._house_relief = bodies.HOUSE[2][0] - 3.0 * tilt
         half = [0.5 * (hi - lo) for lo, hi in bodies.HOUSE]
         self._house_radius = math.sqrt(sum(h * h for h in half))
+        self._house_mid = tuple(0.5 * (lo + hi) for lo, hi in bodies.HOUSE)
+        m = self.m
+        along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
+        half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
+        self._bucket_sphere = along, back, math.sqrt(sum(h * h for h in half))
+        # That sphere misses the box's 0.05 m beyond the bucket pin; with this much more
+        # radius it contains the box (its bound may then rule the bucket out).
+        along_half = 0.5 * (m.L4 + 0.2)  # bodies.bucket_box: -0.15 to L4 + 0.05 along u
+        contain = math.sqrt(along_half**2 + half[1] ** 2 + half[2] ** 2)
+        self._sphere_slack = {"bucket": contain - self._bucket_sphere[2] + 1e-9, "house": 0.0}
+        self._swing_axis, self._up = bodies.swing_axis(self.rotation, m.L0)
         origin = ((0.0, 0.0, 0.0),) * 4  # the tracks do not depend on the arm
         self._tracks_box = bodies.machine_bodies(
             origin, 0.0, self.rotation, self.m.bucket_width, self.m.L0, ("tracks",)
@@ -296,8 +314,14 @@ class ExcavatorWorldV1(ExcavatorWorld):
         gap = pose.low_edge - self._relief_max
         if gap > 0.0:
             return -gap
-        h = self.terrain.height_at
-        return max(h(p[0], p[1]) - p[2] for p in pose.edge)
+        t = self.terrain
+        memo = pose.edge_memo
+        if memo[0] is t and memo[1] == t.version:
+            return memo[2]
+        h = t.height_at
+        depth = max(h(p[0], p[1]) - p[2] for p in pose.edge)
+        pose.edge_memo = (t, t.version, depth)
+        return depth
 
     def _penetration(self, pose: Pose) -> float:
         """Deepest point of the bodies' undersides below the ground (m; negative: above).
@@ -310,8 +334,14 @@ class ExcavatorWorldV1(ExcavatorWorld):
         gap = (low if low < self._house_relief else self._house_relief) - self._relief_max
         if gap > 0.0:
             return -gap
-        h = self.terrain.height_at
-        return max(h(p[0], p[1]) - p[2] for p in pose.under())
+        t = self.terrain
+        memo = pose.body_memo
+        if memo[0] is t and memo[1] == t.version:
+            return memo[2]
+        h = t.height_at
+        depth = max(h(p[0], p[1]) - p[2] for p in pose.under())
+        pose.body_memo = (t, t.version, depth)
+        return depth
 
     def _deposit(self, x: float, y: float, volume: float) -> None:
         """Soil on the ground at ``(x, y)``; the relief bound follows."""
@@ -365,64 +395,98 @@ class ExcavatorWorldV1(ExcavatorWorld):
         link's within its radius; house and tracks within ``HOUSE_RADIUS``
         of the swing axis) against the obstacle's bounding circle in plan
         and its top; the bucket's bounding sphere next; a body is built only
-        when its bound is under its horizon.
+        when its bound is under its horizon. A clearance is the smallest of
+        these values; a part whose bound (``SKIP`` above it to cover
+        rounding) is not below the smallest so far cannot change it and is
+        left out: the values are those of computing every part.
         """
         pts = self.points
-        reach = (bodies.BOOM_RADIUS, bodies.STICK_RADIUS, UNDER_REACH)
+        z0, z1, z2, z3 = pts[0][2], pts[1][2], pts[2][2], pts[3][2]
+        lows = (z1 if z1 < z0 else z0, z2 if z2 < z1 else z1, z3 if z3 < z2 else z2)
         cache: dict = {}
-        best = math.inf
+        self.pipe_clear = self._pipe_clearance(cache, lows)
+        self.truck_clear = self._truck_clearance(cache, lows)
+        self.self_clear = self._self_clearance(cache, lows)
+
+    def _pipe_clearance(self, cache: dict, lows) -> float:
+        top, best = self._pipe_top, math.inf
         for k, name in enumerate(PARTS):
-            d = min(pts[k][2], pts[k + 1][2]) - reach[k] - self._pipe_top
+            d = lows[k] - REACH[k] - top
             if d < HORIZON:
-                d = self._exact(cache, name, self._pipe_body, self._pipe_gap, HORIZON)
-            best = d if d < best else best
-        self.pipe_clear = best
+                if d - best >= SKIP:
+                    continue
+                d = self._exact(cache, name, self._pipe_body, self._pipe_gap, HORIZON, best)
+            if d < best:
+                best = d
+        return best
+
+    def _truck_clearance(self, cache: dict, lows) -> float:
+        pts, box = self.points, self._truck_body
         cx, cy = self._truck_centre
+        radius, height = self._truck_radius, self.truck.height
         best = self._house_truck
         if best < SELF_HORIZON:
-            best = self._exact(cache, "house", self._truck_body, self._truck_body.gap, SELF_HORIZON)
+            best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
         for k, name in enumerate(PARTS):
-            plan = _plan_gap(pts[k], pts[k + 1], cx, cy) - self._truck_radius
-            above = min(pts[k][2], pts[k + 1][2]) - self.truck.height
-            d = max(plan, above) - reach[k]
+            plan = _plan_gap(pts[k], pts[k + 1], cx, cy) - radius
+            above = lows[k] - height
+            d = (above if above > plan else plan) - REACH[k]
             if d < HORIZON:
-                d = self._exact(cache, name, self._truck_body, self._truck_body.gap, HORIZON)
-            best = d if d < best else best
-        self.truck_clear = best
+                if d - best >= SKIP:
+                    continue
+                d = self._exact(cache, name, box, box.gap, HORIZON, best)
+            if d < best:
+                best = d
+        return best
+
+    def _self_clearance(self, cache: dict, lows) -> float:
+        pts = self.points
         ax, ay = self._axis
         best = math.inf
-        for k, name in ((1, "stick"), (2, "bucket")):
+        for k, name in ((2, "bucket"), (1, "stick")):  # the bucket's cheap sphere bounds first
             plan = _plan_gap(pts[k], pts[k + 1], ax, ay) - HOUSE_RADIUS
-            above = min(pts[k][2], pts[k + 1][2]) - self._house_top
-            d = max(plan, above) - reach[k]
-            if d < SELF_HORIZON:
-                d = min(
-                    self._exact(cache, name, self._part(cache, other), None, SELF_HORIZON)
-                    for other in ("tracks", "house")
-                )
-            best = d if d < best else best
-        self.self_clear = best
+            above = lows[k] - self._house_top
+            d = (above if above > plan else plan) - REACH[k]
+            if d >= SELF_HORIZON:
+                if d < best:
+                    best = d
+            elif d - best < SKIP:
+                for other in ("tracks", "house"):
+                    d = self._exact(cache, name, self._part(cache, other), None, SELF_HORIZON, best)
+                    if d < best:
+                        best = d
+        return best
 
-    def _exact(self, cache: dict, name: str, other, gap, horizon: float) -> float:
+    def _exact(self, cache: dict, name: str, other, gap, horizon: float, best=math.inf) -> float:
         """Distance of part ``name`` to ``other``; for a box, its sphere's and its
-        separating axes' bounds first (the bound is returned when not under ``horizon``)."""
+        separating axes' bounds first (the bound is returned when not under ``horizon``).
+
+        A bound ``SKIP`` or more above ``best`` is returned as it is (the
+        distance, not smaller, would not be the smallest either).
+        """
         if name == "bucket" or name == "house":
-            c, r = self._sphere(name)
+            c, r = self._sphere(cache, name)
             d = (gap(c) if gap is not None else other.gap(c)) - r
-            if d >= horizon:
+            if d >= horizon or d - self._sphere_slack[name] - best >= SKIP:
                 return d
             body = self._part(cache, name)
             d = bodies.lower_bound(body, other)
-            if d >= horizon:
+            if d >= horizon or d - best >= SKIP:
                 return d
             return bodies.distance(body, other)
+        if isinstance(other, bodies.Box):
+            k, pts = PARTS.index(name), self.points
+            return bodies.segment_to_box(pts[k], pts[k + 1], other, best + REACH[k]) - REACH[k]
         return bodies.distance(self._part(cache, name), other)
 
     def _part(self, cache: dict, name: str):
         if name == "tracks":
             return self._tracks_box
         if name not in cache:
-            cache.update(self._bodies((name,)))
+            if name == "house":
+                cache[name] = bodies.house_box(self._swing_axis, self._up, self.q[0], self.rotation)
+            else:
+                cache.update(self._bodies((name,)))
         return cache[name]
 
     def _pipe_gap(self, c) -> float:
@@ -439,21 +503,27 @@ class ExcavatorWorldV1(ExcavatorWorld):
             self.points, self.q[0], self.rotation, self.m.bucket_width, self.m.L0, names
         )
 
-    def _sphere(self, name: str) -> tuple[tuple[float, float, float], float]:
+    def _sphere(self, cache: dict, name: str) -> tuple[tuple[float, float, float], float]:
         """Bounding sphere ``(centre, radius)`` of the bucket's or the house's body."""
-        m = self.m
+        key = (name, "sphere")
+        if key in cache:
+            return cache[key]
         if name == "bucket":
             pin, pose = self.points[2], self._pose_now
-            along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
+            along, back, radius = self._bucket_sphere
             u, n = pose.u, pose.n
-            centre = tuple(pin[i] + along * u[i] - back * n[i] for i in range(3))
-            half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
-            return centre, math.sqrt(sum(h * h for h in half))
+            centre = (
+                pin[0] + along * u[0] - back * n[0],
+                pin[1] + along * u[1] - back * n[1],
+                pin[2] + along * u[2] - back * n[2],
+            )
+            cache[key] = centre, radius
+            return cache[key]
         c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
-        (x0, x1), (y0, y1), (z0, z1) = bodies.HOUSE
-        x, y = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-        house = (-m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, 0.5 * (z0 + z1))
-        return (self._rot(house) if self.rotation else house), self._house_radius
+        x, y, z = self._house_mid
+        house = (-self.m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, z)
+        cache[key] = (self._rot(house) if self.rotation else house), self._house_radius
+        return cache[key]
 
 
 def _plan_gap(a, b, x: float, y: float) -> float:
@@ -464,19 +534,6 @@ def _plan_gap(a, b, x: float, y: float) -> float:
     t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
     t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
     return math.hypot(px - t * dx, py - t * dy)
-
-
-def _mid(a, b) -> tuple[float, float, float]:
-    return (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]))
-
-
-def _near(body, other) -> float:
-    """Exact distance when under ``HORIZON``, else a lower bound from ``body``'s sphere."""
-    centre, radius = body.sphere()
-    bound = bodies.distance(bodies.Capsule(centre, centre, radius), other)
-    if bound >= HORIZON:
-        return bound
-    return bodies.distance(body, other)
 
 
 def _lerp(a, b, t: float) -> list[float]:
