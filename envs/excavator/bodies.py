@@ -148,20 +148,12 @@ def segment_to_box(a, b, box: Box, above: float = math.inf) -> float:
     that far from the box's slab). When it is ``SKIP`` or more above
     ``above``, the bound is returned instead of the distance.
     """
-    la, lb = box.local(a), box.local(b)
-    hx, hy, hz = box.half
+    la, lb, half = box.local(a), box.local(b), box.half
     if above < math.inf:
-        total = 0.0
-        for p, q, h in ((la[0], lb[0], hx), (la[1], lb[1], hy), (la[2], lb[2], hz)):
-            g = (p if p < q else q) - h
-            if g <= 0.0:
-                g = -h - (q if p < q else p)
-            if g > 0.0:
-                total += g * g
-        bound = math.sqrt(total)
+        bound = _aabb_gap(la, lb, half)
         if bound - above >= SKIP:
             return bound
-    return segment_box_distance(la, lb, (-hx, -hy, -hz), box.half)
+    return segment_box_distance(la, lb, (-half[0], -half[1], -half[2]), half)
 
 
 def separation(p: Box, q: Box) -> float:
@@ -179,18 +171,49 @@ def separation(p: Box, q: Box) -> float:
 
 
 def box_to_box(p: Box, q: Box) -> float:
-    """Distance between two boxes (0 when they overlap)."""
+    """Distance between two boxes (0 when they overlap).
+
+    The smallest distance from an edge of one box to the other box, both
+    ways. Each box's corners are put in the other's frame once; the edges
+    are visited from the smallest bounding-box bound (as in
+    :func:`segment_to_box`) up, and the visit stops at a bound ``SKIP``
+    above the smallest distance so far (no later edge can be closer).
+    """
     if p.contains(q.centre) or q.contains(p.centre):
         return 0.0
     best = math.inf
     for one, other in ((p, q), (q, p)):
-        for a, b in one.edges():
-            d = segment_to_box(a, b, other)
+        corners = [other.local(c) for c in one.corners()]
+        half = other.half
+        low = (-half[0], -half[1], -half[2])
+        edges = sorted(
+            (_aabb_gap(corners[i], corners[i | bit], half), i, i | bit)
+            for bit in (4, 2, 1)
+            for i in range(8)
+            if not i & bit
+        )
+        for bound, i, j in edges:
+            if bound - best >= SKIP:
+                break
+            d = segment_box_distance(corners[i], corners[j], low, half)
             if d < best:
                 best = d
                 if d == 0.0:
                     return 0.0
     return best
+
+
+def _aabb_gap(a: Vec, b: Vec, half: Vec) -> float:
+    """Distance from the segment ``a b``'s bounding box to the box ``[-half, half]``
+    (one frame): a lower bound of the segment's distance to that box."""
+    total = 0.0
+    for p, q, h in ((a[0], b[0], half[0]), (a[1], b[1], half[1]), (a[2], b[2], half[2])):
+        g = (p if p < q else q) - h
+        if g <= 0.0:
+            g = -h - (q if p < q else p)
+        if g > 0.0:
+            total += g * g
+    return math.sqrt(total)
 
 
 def lower_bound(p, q) -> float:
@@ -257,7 +280,7 @@ def machine_bodies(
             lateral = rot((math.sin(swing), -math.cos(swing), 0.0))
             out[name] = bucket_box(pin, tip, lateral, bucket_width)
         elif name == "house":
-            out[name] = house_box(axis, up, swing, rotation)
+            out[name] = house_box(axis, up, math.cos(swing), math.sin(swing), rotation)
         else:
             out[name] = box_from_ranges(
                 axis, (rot((1.0, 0.0, 0.0)), rot((0.0, 1.0, 0.0)), up), TRACKS
@@ -271,12 +294,16 @@ def swing_axis(rotation, L0: float) -> tuple[Vec, Vec]:
     return rot((-L0, 0.0, 0.0)), rot((0.0, 0.0, 1.0))
 
 
-def house_box(axis: Vec, up: Vec, swing: float, rotation) -> Box:
-    """The house's body at the swing angle; ``axis`` (where the swing axis meets the
-    ground) and ``up`` (the base's z) in frame O, ``rotation`` as in :func:`machine_bodies`."""
-    c1, s1 = math.cos(swing), math.sin(swing)
-    rot = _apply(rotation)
-    return box_from_ranges(axis, (rot((c1, s1, 0.0)), rot((-s1, c1, 0.0)), up), HOUSE)
+def house_box(axis: Vec, up: Vec, c1: float, s1: float, rotation) -> Box:
+    """The house's body at the swing angle of cosine ``c1`` and sine ``s1``; ``axis``
+    and ``up`` as :func:`swing_axis` gives them, ``rotation`` as in :func:`machine_bodies`."""
+    if rotation is None:
+        ahead, side = (c1, s1, 0.0), (-s1, c1, 0.0)
+    else:  # R (c1, s1, 0) and R (-s1, c1, 0), as _apply
+        (a, b, c), (d, e, f), (g, h, i) = rotation
+        ahead = (a * c1 + b * s1 + c * 0.0, d * c1 + e * s1 + f * 0.0, g * c1 + h * s1 + i * 0.0)
+        side = (a * -s1 + b * c1 + c * 0.0, d * -s1 + e * c1 + f * 0.0, g * -s1 + h * c1 + i * 0.0)
+    return box_from_ranges(axis, (ahead, side, up), HOUSE)
 
 
 def _apply(rotation):

@@ -26,11 +26,12 @@ from __future__ import annotations
 
 def hydraulic_rates(values, qdot, m, dt: float) -> list[float]:
     """Joint rates (rad/s) after the pump-flow and acceleration limits (see the module)."""
+    rate_max = m.rate_max
     cmd = [
         (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * r
-        for v, r in zip(values, m.rate_max, strict=True)
+        for v, r in zip(values, rate_max, strict=True)
     ]
-    demand = sum(abs(c) / r * s for c, r, s in zip(cmd, m.rate_max, m.pump_share, strict=True))
+    demand = sum([abs(c) / r * s for c, r, s in zip(cmd, rate_max, m.pump_share, strict=True)])
     if demand > 1.0:
         cmd = [c / demand for c in cmd]
     out = []

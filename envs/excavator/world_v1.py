@@ -77,6 +77,8 @@ class Pose:
         "low_arm",
         "low_edge",
         "_world",
+        "c1",
+        "s1",
         "edge_memo",
         "body_memo",
     )
@@ -88,7 +90,7 @@ class Pose:
         m, r = world.m, world.rotation
         q1, q2, q3, q4 = q
         pts = arm_points(q1, q2, q3, q4, m)
-        c1, s1 = math.cos(q1), math.sin(q1)
+        self.c1, self.s1 = c1, s1 = math.cos(q1), math.sin(q1)
         beta = q2 + q3 + q4
         cb, sb = math.cos(beta), math.sin(beta)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
@@ -120,7 +122,7 @@ class Pose:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
         world = self._world
         m, rot = world.m, world._rot if world.rotation is not None else None
-        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
+        c1, s1 = self.c1, self.s1
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
         out = [
             (x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0)
@@ -163,6 +165,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._truck_centre = (truck.cx, truck.cy)
         self._truck_radius = math.hypot(truck.half_length, truck.half_width)
         self._axis = (-self.m.L0, 0.0)
+        self._limits = tuple((lo, hi) for _, _, lo, hi in self._joints)
         self._edge_half = 0.5 * self.m.bucket_width - 0.05  # the edge's half-width past the plates
         # The house stays within HOUSE_RADIUS of the axis: its bound to the truck is fixed.
         self._house_truck = (
@@ -209,33 +212,27 @@ class ExcavatorWorldV1(ExcavatorWorld):
     # ------------------------------------------------------------------ step
     def advance(self, values: list[float]) -> None:
         m, dt = self.m, self.dt
-        q0 = list(self.q)
+        q0 = self.q
         rates = hydraulic_rates(values, self.qdot, m, dt)
         target = []
-        for (k, _, lo, hi), r in zip(self._joints, rates, strict=True):
-            new = q0[k] + r * dt
+        for a, r, (lo, hi) in zip(q0, rates, self._limits, strict=True):
+            new = a + r * dt
             target.append(lo if new < lo else hi if new > hi else new)
-        pose0, pose1 = self._pose_now, self._pose(target)
-        v = tuple(b - a for a, b in zip(pose0.tip, pose1.tip, strict=True))
+        pose0, pose1 = self._pose_now, Pose(target, self)
         depth1 = self._edge_depth(pose1)
-        cutting = self.carve and depth1 > 0.0 and cuts(v, pose1.n)
-        edge0, body0 = self._edge_depth(pose0), self._penetration(pose0)
-
-        def free(pose: Pose) -> bool:
-            # Into the ground only where a part is not yet, or on its way out.
-            body = self._penetration(pose)
-            if body > DEPTH_TOLERANCE and body >= body0:
-                return False
-            if cutting:
-                return True
-            edge = self._edge_depth(pose)
-            return edge <= DEPTH_TOLERANCE or edge < edge0
-
-        t, pose = 1.0, pose1
+        cutting = False
+        if self.carve and depth1 > 0.0:
+            tip0, tip1 = pose0.tip, pose1.tip
+            v = (tip1[0] - tip0[0], tip1[1] - tip0[1], tip1[2] - tip0[2])
+            cutting = cuts(v, pose1.n)
+        # The pose's ground tests (free, below), with the old pose's depths read only when needed.
         body1 = self._penetration(pose1)
-        body_stop = body1 > DEPTH_TOLERANCE and body1 >= body0
-        if body_stop or not free(pose1):
-            t, pose = self._bisect(q0, target, free)
+        body_stop = body1 > DEPTH_TOLERANCE and body1 >= self._penetration(pose0)
+        t, pose = 1.0, pose1
+        if body_stop or not (
+            cutting or depth1 <= DEPTH_TOLERANCE or depth1 < self._edge_depth(pose0)
+        ):
+            t, pose = self._bisect(q0, target, self._free(pose0, cutting))
         self.cut_force = cutting_force(depth1, m.bucket_width, m) if cutting else 0.0
         if cutting:
             f = stall_fraction(self.cut_force, m.dig_force)
@@ -243,8 +240,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 t, pose = f, self._pose(_lerp(q0, target, f))
         self.ground_contact = 1.0 if body_stop else 0.0
         self.advance_fraction = t
-        self.q = list(pose.q)
-        self.qdot = [(a - b) / dt for a, b in zip(self.q, q0, strict=True)]
+        self.q = q = list(pose.q)
+        self.qdot = [(a - b) / dt for a, b in zip(q, q0, strict=True)]
         self._set_pose(pose)
         self.steps += 1
         self.elapsed = self.steps * dt
@@ -254,6 +251,22 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 self._cut(pose0, pose)
             self._pour_if_tipped()
         self._clearances()
+
+    def _free(self, pose0: Pose, cutting: bool):
+        """The test of a pose reached from ``pose0``: into the ground only where a part
+        is not yet, or on its way out (the edge: or while it cuts)."""
+        edge0, body0 = self._edge_depth(pose0), self._penetration(pose0)
+
+        def free(pose: Pose) -> bool:
+            body = self._penetration(pose)
+            if body > DEPTH_TOLERANCE and body >= body0:
+                return False
+            if cutting:
+                return True
+            edge = self._edge_depth(pose)
+            return edge <= DEPTH_TOLERANCE or edge < edge0
+
+        return free
 
     def _bisect(self, q0, target, free) -> tuple[float, Pose]:
         """The largest fraction of the step (to 1/64) whose pose is ``free``."""
@@ -484,7 +497,10 @@ class ExcavatorWorldV1(ExcavatorWorld):
             return self._tracks_box
         if name not in cache:
             if name == "house":
-                cache[name] = bodies.house_box(self._swing_axis, self._up, self.q[0], self.rotation)
+                pose = self._pose_now
+                cache[name] = bodies.house_box(
+                    self._swing_axis, self._up, pose.c1, pose.s1, self.rotation
+                )
             else:
                 cache.update(self._bodies((name,)))
         return cache[name]
@@ -519,7 +535,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
             )
             cache[key] = centre, radius
             return cache[key]
-        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
+        c1, s1 = self._pose_now.c1, self._pose_now.s1
         x, y, z = self._house_mid
         house = (-self.m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, z)
         cache[key] = (self._rot(house) if self.rotation else house), self._house_radius
