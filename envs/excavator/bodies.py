@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from motiongym.envs.excavator.obstacles import segment_box_distance
 from motiongym.envs.geometry import segment_distance
@@ -70,9 +71,11 @@ class Capsule:
         return c, 0.5 * math.dist(self.a, self.b) + self.radius
 
 
-@dataclass(frozen=True)
-class Box:
-    """An oriented box: centre, unit axes (rows), half extents (m)."""
+class Box(NamedTuple):
+    """An oriented box: centre, unit axes (rows), half extents (m).
+
+    A named tuple (immutable, compared by value): a step builds a few.
+    """
 
     centre: Vec
     axes: tuple[Vec, Vec, Vec]
@@ -159,13 +162,14 @@ def segment_to_box(a, b, box: Box, above: float = math.inf) -> float:
 def separation(p: Box, q: Box) -> float:
     """A lower bound of the distance between two boxes: the widest gap between their
     projections on the six face normals (separating-axis test; <= 0: not separated)."""
-    d = tuple(b - a for a, b in zip(p.centre, q.centre, strict=True))
+    (px, py, pz), (qx, qy, qz) = p.centre, q.centre
+    dx, dy, dz = qx - px, qy - py, qz - pz
+    sides = [(h, a) for box in (p, q) for h, a in zip(box.half, box.axes, strict=True)]
     best = -math.inf
-    for axis in (*p.axes, *q.axes):
-        along = abs(d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2])
-        for box in (p, q):
-            for h, a in zip(box.half, box.axes, strict=True):
-                along -= h * abs(a[0] * axis[0] + a[1] * axis[1] + a[2] * axis[2])
+    for x, y, z in (*p.axes, *q.axes):
+        along = abs(dx * x + dy * y + dz * z)
+        for h, (a, b, c) in sides:
+            along -= h * abs(a * x + b * y + c * z)
         best = along if along > best else best
     return best
 

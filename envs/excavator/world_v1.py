@@ -42,7 +42,14 @@ from motiongym.envs.excavator import bodies
 from motiongym.envs.excavator.digging import DEPTH_TOLERANCE, PUSH, cuts, stall_fraction
 from motiongym.envs.excavator.hydraulics import hydraulic_rates
 from motiongym.envs.excavator.kinematics import arm_points, base_rotation
-from motiongym.envs.excavator.scenes import CELL_XS, CELL_YS, ground_plane
+from motiongym.envs.excavator.scenes import (
+    CELL_XS,
+    CELL_YS,
+    GRID_CELL,
+    GRID_ORIGIN,
+    GRID_SHAPE,
+    ground_plane,
+)
 from motiongym.envs.excavator.soil import cutting_force
 from motiongym.envs.excavator.world import HORIZON, POUR_NZ, POUR_TIME, ExcavatorWorld
 
@@ -189,6 +196,13 @@ class ExcavatorWorldV1(ExcavatorWorld):
         # + 0.01 m: the plane's change within a cell (the map holds cell centres).
         self._relief_max = float((scene.heights - self._plane).max()) + 0.01
         tilt = math.hypot(self._gx, self._gy)
+        # The plane's change from a cell's centre to its corners, and the map's extent.
+        self._cell_tilt = 0.5 * GRID_CELL * (abs(self._gx) + abs(self._gy)) + SKIP
+        nx, ny = GRID_SHAPE
+        self._map_xy = (
+            (GRID_ORIGIN[0], GRID_ORIGIN[0] + nx * GRID_CELL),
+            (GRID_ORIGIN[1], GRID_ORIGIN[1] + ny * GRID_CELL),
+        )
         self._house_relief = bodies.HOUSE[2][0] - 3.0 * tilt
         half = [0.5 * (hi - lo) for lo, hi in bodies.HOUSE]
         self._house_radius = math.sqrt(sum(h * h for h in half))
@@ -337,11 +351,15 @@ class ExcavatorWorldV1(ExcavatorWorld):
         return depth
 
     def _penetration(self, pose: Pose) -> float:
-        """Deepest point of the bodies' undersides below the ground (m; negative: above).
+        """Deepest point of the bodies' undersides below the ground (m; negative: above),
+        exact where it matters: over ``DEPTH_TOLERANCE``, else a value not over it.
 
         The undersides lie at most ``UNDER_REACH`` below the arm points and the
         house's corners at least ``0.95 - 3 tan(tilt)`` above the plane: above
-        the highest relief by more, a negative bound is returned.
+        the highest relief by more, a negative bound is returned. A point that
+        the relief bound alone keeps out of that tolerance is not looked up in
+        the map (its bound stands for it: the steps' ground tests compare a
+        depth with the tolerance, and two depths only when one is over it).
         """
         low = pose.low_arm - UNDER_REACH
         gap = (low if low < self._house_relief else self._house_relief) - self._relief_max
@@ -351,8 +369,16 @@ class ExcavatorWorldV1(ExcavatorWorld):
         memo = pose.body_memo
         if memo[0] is t and memo[1] == t.version:
             return memo[2]
-        h = t.height_at
-        depth = max(h(p[0], p[1]) - p[2] for p in pose.under())
+        h, gx, gy = t.height_at, self._gx, self._gy
+        relief = self._relief_max + self._cell_tilt  # over the plane anywhere in a cell
+        (x0, x1), (y0, y1) = self._map_xy
+        depth = -math.inf
+        for x, y, z in pose.under():
+            d = relief + gx * x + gy * y - z
+            if d > DEPTH_TOLERANCE - SKIP or not (x0 < x < x1 and y0 < y < y1):
+                d = h(x, y) - z
+            if d > depth:
+                depth = d
         pose.body_memo = (t, t.version, depth)
         return depth
 
@@ -434,16 +460,12 @@ class ExcavatorWorldV1(ExcavatorWorld):
         return best
 
     def _truck_clearance(self, cache: dict, lows) -> float:
-        pts, box = self.points, self._truck_body
-        cx, cy = self._truck_centre
-        radius, height = self._truck_radius, self.truck.height
-        best = self._house_truck
+        box, best = self._truck_body, self._house_truck
         if best < SELF_HORIZON:
             best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
-        for k, name in enumerate(PARTS):
-            plan = _plan_gap(pts[k], pts[k + 1], cx, cy) - radius
-            above = lows[k] - height
-            d = (above if above > plan else plan) - REACH[k]
+        cx, cy = self._truck_centre
+        bounds = _part_bounds(self.points, lows, cx, cy, self._truck_radius, self.truck.height, 0)
+        for name, d in zip(PARTS, bounds, strict=True):
             if d < HORIZON:
                 if d - best >= SKIP:
                     continue
@@ -453,13 +475,10 @@ class ExcavatorWorldV1(ExcavatorWorld):
         return best
 
     def _self_clearance(self, cache: dict, lows) -> float:
-        pts = self.points
         ax, ay = self._axis
+        stick, bucket = _part_bounds(self.points, lows, ax, ay, HOUSE_RADIUS, self._house_top, 1)
         best = math.inf
-        for k, name in ((2, "bucket"), (1, "stick")):  # the bucket's cheap sphere bounds first
-            plan = _plan_gap(pts[k], pts[k + 1], ax, ay) - HOUSE_RADIUS
-            above = lows[k] - self._house_top
-            d = (above if above > plan else plan) - REACH[k]
+        for name, d in (("bucket", bucket), ("stick", stick)):  # the bucket's cheap bounds first
             if d >= SELF_HORIZON:
                 if d < best:
                     best = d
@@ -521,7 +540,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
 
     def _sphere(self, cache: dict, name: str) -> tuple[tuple[float, float, float], float]:
         """Bounding sphere ``(centre, radius)`` of the bucket's or the house's body."""
-        key = (name, "sphere")
+        key = _SPHERE_KEYS[name]
         if key in cache:
             return cache[key]
         if name == "bucket":
@@ -542,14 +561,26 @@ class ExcavatorWorldV1(ExcavatorWorld):
         return cache[key]
 
 
-def _plan_gap(a, b, x: float, y: float) -> float:
-    """Plan-view distance from the point ``(x, y)`` to the segment ``a b``."""
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    px, py = x - a[0], y - a[1]
-    length2 = dx * dx + dy * dy
-    t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
-    t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-    return math.hypot(px - t * dx, py - t * dy)
+_SPHERE_KEYS = {"bucket": "bucket sphere", "house": "house sphere"}  # in a step's cache
+
+
+def _part_bounds(pts, lows, x: float, y: float, radius: float, top: float, first: int):
+    """Lower bounds of the distances of the parts from ``first`` on (0 boom, 1 stick,
+    2 bucket) to a body within ``radius`` of the vertical line at ``(x, y)`` and below
+    ``top``: the larger of the segment's plan-view gap and its height over ``top``, less
+    the part's reach (``REACH``)."""
+    out = []
+    for k in range(first, 3):
+        a, b = pts[k], pts[k + 1]
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        px, py = x - a[0], y - a[1]
+        length2 = dx * dx + dy * dy
+        t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
+        t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+        plan = math.hypot(px - t * dx, py - t * dy) - radius
+        above = lows[k] - top
+        out.append((above if above > plan else plan) - REACH[k])
+    return out
 
 
 def _lerp(a, b, t: float) -> list[float]:
