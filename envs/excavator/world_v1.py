@@ -80,7 +80,6 @@ class Pose:
         "n",
         "u",
         "lat",
-        "edge",
         "low_arm",
         "low_edge",
         "_world",
@@ -112,11 +111,6 @@ class Pose:
         self.n, self.u, self.lat = n, u, lat
         tip, half = pts[3], world._edge_half
         lx, ly, lz = half * lat[0], half * lat[1], half * lat[2]
-        self.edge = (
-            (tip[0] + lx, tip[1] + ly, tip[2] + lz),
-            tip,
-            (tip[0] - lx, tip[1] - ly, tip[2] - lz),
-        )
         # Heights above the ground plane: of the lowest arm point past the foot, and the edge.
         gx, gy = world._gx, world._gy
         _, (x1, y1, z1), (x2, y2, z2), (x3, y3, z3) = pts
@@ -124,6 +118,16 @@ class Pose:
         low = h2 if h2 < h1 else h1
         self.low_arm = h3 if h3 < low else low
         self.low_edge = tip[2] - gx * tip[0] - gy * tip[1] - abs(lz) - abs(gx * lx + gy * ly)
+
+    def edge(self) -> tuple[tuple[float, float, float], ...]:
+        """The cutting edge's two ends and its middle (the tip), O."""
+        tip, half, lat = self.tip, self._world._edge_half, self.lat
+        lx, ly, lz = half * lat[0], half * lat[1], half * lat[2]
+        return (
+            (tip[0] + lx, tip[1] + ly, tip[2] + lz),
+            tip,
+            (tip[0] - lx, tip[1] - ly, tip[2] - lz),
+        )
 
     def under(self) -> list[tuple[float, float, float]]:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
@@ -346,7 +350,7 @@ class ExcavatorWorldV1(ExcavatorWorld):
         if memo[0] is t and memo[1] == t.version:
             return memo[2]
         h = t.height_at
-        depth = max(h(p[0], p[1]) - p[2] for p in pose.edge)
+        depth = max(h(p[0], p[1]) - p[2] for p in pose.edge())
         pose.edge_memo = (t, t.version, depth)
         return depth
 
@@ -396,8 +400,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
     def _cut(self, pose0: Pose, pose1: Pose) -> None:
         """Carve the edge's sweep; the bucket takes what it holds, the rest is pushed ahead."""
         m = self.m
-        e0 = ((pose0.edge[0][0], pose0.edge[0][1]), (pose0.edge[2][0], pose0.edge[2][1]))
-        e1 = ((pose1.edge[0][0], pose1.edge[0][1]), (pose1.edge[2][0], pose1.edge[2][1]))
+        (a0, _, b0), (a1, _, b1) = pose0.edge(), pose1.edge()
+        e0, e1 = ((a0[0], a0[1]), (b0[0], b0[1])), ((a1[0], a1[1]), (b1[0], b1[1]))
         removed = self.terrain.carve(e0, e1, pose0.tip[2], pose1.tip[2], math.inf)
         if removed <= 0.0:
             return
@@ -443,9 +447,10 @@ class ExcavatorWorldV1(ExcavatorWorld):
         z0, z1, z2, z3 = pts[0][2], pts[1][2], pts[2][2], pts[3][2]
         lows = (z1 if z1 < z0 else z0, z2 if z2 < z1 else z1, z3 if z3 < z2 else z2)
         cache: dict = {}
+        to_truck, to_axis = _plan_gaps(pts, self._truck_centre, self._axis)
         self.pipe_clear = self._pipe_clearance(cache, lows)
-        self.truck_clear = self._truck_clearance(cache, lows)
-        self.self_clear = self._self_clearance(cache, lows)
+        self.truck_clear = self._truck_clearance(cache, lows, to_truck)
+        self.self_clear = self._self_clearance(cache, lows, to_axis)
 
     def _pipe_clearance(self, cache: dict, lows) -> float:
         top, best = self._pipe_top, math.inf
@@ -459,13 +464,14 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 best = d
         return best
 
-    def _truck_clearance(self, cache: dict, lows) -> float:
+    def _truck_clearance(self, cache: dict, lows, plan) -> float:
         box, best = self._truck_body, self._house_truck
         if best < SELF_HORIZON:
             best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
-        cx, cy = self._truck_centre
-        bounds = _part_bounds(self.points, lows, cx, cy, self._truck_radius, self.truck.height, 0)
-        for name, d in zip(PARTS, bounds, strict=True):
+        radius, height = self._truck_radius, self.truck.height
+        for k, name in enumerate(PARTS):
+            gap, above = plan[k] - radius, lows[k] - height
+            d = (above if above > gap else gap) - REACH[k]
             if d < HORIZON:
                 if d - best >= SKIP:
                     continue
@@ -474,11 +480,11 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 best = d
         return best
 
-    def _self_clearance(self, cache: dict, lows) -> float:
-        ax, ay = self._axis
-        stick, bucket = _part_bounds(self.points, lows, ax, ay, HOUSE_RADIUS, self._house_top, 1)
-        best = math.inf
-        for name, d in (("bucket", bucket), ("stick", stick)):  # the bucket's cheap bounds first
+    def _self_clearance(self, cache: dict, lows, plan) -> float:
+        best, top = math.inf, self._house_top
+        for k, name in ((2, "bucket"), (1, "stick")):  # the bucket's cheap bounds first
+            gap, above = plan[k - 1] - HOUSE_RADIUS, lows[k] - top
+            d = (above if above > gap else gap) - REACH[k]
             if d >= SELF_HORIZON:
                 if d < best:
                     best = d
@@ -557,30 +563,32 @@ class ExcavatorWorldV1(ExcavatorWorld):
         c1, s1 = self._pose_now.c1, self._pose_now.s1
         x, y, z = self._house_mid
         house = (-self.m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, z)
-        cache[key] = (self._rot(house) if self.rotation else house), self._house_radius
+        if self.rotation:
+            (a, b, c), (d, e, f), (g, h, i) = self.rotation
+            x, y, z = house
+            house = (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+        cache[key] = house, self._house_radius
         return cache[key]
 
 
 _SPHERE_KEYS = {"bucket": "bucket sphere", "house": "house sphere"}  # in a step's cache
 
 
-def _part_bounds(pts, lows, x: float, y: float, radius: float, top: float, first: int):
-    """Lower bounds of the distances of the parts from ``first`` on (0 boom, 1 stick,
-    2 bucket) to a body within ``radius`` of the vertical line at ``(x, y)`` and below
-    ``top``: the larger of the segment's plan-view gap and its height over ``top``, less
-    the part's reach (``REACH``)."""
-    out = []
-    for k in range(first, 3):
-        a, b = pts[k], pts[k + 1]
+def _plan_gaps(pts, p, q) -> tuple[list[float], list[float]]:
+    """Plan-view distances from the point ``p`` to the arm's three segments (boom,
+    stick, bucket) and from ``q`` to the last two."""
+    to_p, to_q = [], []
+    a = pts[0]
+    for b in pts[1:]:
         dx, dy = b[0] - a[0], b[1] - a[1]
-        px, py = x - a[0], y - a[1]
         length2 = dx * dx + dy * dy
-        t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
-        t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-        plan = math.hypot(px - t * dx, py - t * dy) - radius
-        above = lows[k] - top
-        out.append((above if above > plan else plan) - REACH[k])
-    return out
+        for (x, y), out in ((p, to_p), (q, to_q)) if to_p else ((p, to_p),):
+            px, py = x - a[0], y - a[1]
+            t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
+            t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+            out.append(math.hypot(px - t * dx, py - t * dy))
+        a = b
+    return to_p, to_q
 
 
 def _lerp(a, b, t: float) -> list[float]:
