@@ -100,13 +100,19 @@ class Pose:
         beta = q2 + q3 + q4
         cb, sb = math.cos(beta), math.sin(beta)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
-        if r is not None:
+        if r is not None:  # R v for each point and axis
             (a, b, c), (d, e, f), (g, h, i) = r
-            p0, p1, p2, p3, n, u, lat = [
-                (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-                for x, y, z in (*pts, n, u, lat)
-            ]
-            pts = (p0, p1, p2, p3)
+            pts = tuple(
+                [
+                    (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+                    for x, y, z in pts
+                ]
+            )
+            (x, y, z), (x1, y1, z1) = n, u
+            n = (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+            u = (a * x1 + b * y1 + c * z1, d * x1 + e * y1 + f * z1, g * x1 + h * y1 + i * z1)
+            x, y = s1, -c1
+            lat = (a * x + b * y + c * 0.0, d * x + e * y + f * 0.0, g * x + h * y + i * 0.0)
         self.points, self.tip, self.beta = pts, pts[3], beta
         self.n, self.u, self.lat = n, u, lat
         tip, half = pts[3], world._edge_half
