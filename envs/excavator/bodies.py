@@ -136,9 +136,11 @@ def box_from_ranges(origin: Vec, axes, ranges) -> Box:
     (l0, h0), (l1, h1), (l2, h2) = ranges
     m0, m1, m2 = 0.5 * (l0 + h0), 0.5 * (l1 + h1), 0.5 * (l2 + h2)
     a, b, c = axes
-    centre = tuple(
-        origin[i] + sum((m0 * a[i], m1 * b[i], m2 * c[i])) for i in range(3)
-    )  # sum() as the reference: the same rounding on every Python
+    centre = (  # sum() as the reference: the same rounding on every Python
+        origin[0] + sum((m0 * a[0], m1 * b[0], m2 * c[0])),
+        origin[1] + sum((m0 * a[1], m1 * b[1], m2 * c[1])),
+        origin[2] + sum((m0 * a[2], m1 * b[2], m2 * c[2])),
+    )
     half = (0.5 * (h0 - l0), 0.5 * (h1 - l1), 0.5 * (h2 - l2))
     return Box(centre, (tuple(a), tuple(b), tuple(c)), half)
 

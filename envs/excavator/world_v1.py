@@ -459,7 +459,11 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self.self_clear = self._self_clearance(cache, lows, to_axis)
 
     def _pipe_clearance(self, cache: dict, lows) -> float:
-        top, best = self._pipe_top, math.inf
+        top = self._pipe_top
+        d0, d1, d2 = lows[0] - REACH[0] - top, lows[1] - REACH[1] - top, lows[2] - REACH[2] - top
+        if d0 >= HORIZON and d1 >= HORIZON and d2 >= HORIZON:  # far: the bounds stand
+            return min(d0, d1, d2)
+        best = math.inf
         for k, name in enumerate(PARTS):
             d = lows[k] - REACH[k] - top
             if d < HORIZON:
@@ -584,16 +588,18 @@ def _plan_gaps(pts, p, q) -> tuple[list[float], list[float]]:
     """Plan-view distances from the point ``p`` to the arm's three segments (boom,
     stick, bucket) and from ``q`` to the last two."""
     to_p, to_q = [], []
-    a = pts[0]
-    for b in pts[1:]:
-        dx, dy = b[0] - a[0], b[1] - a[1]
+    pairs = ((p, to_p),)
+    (ax, ay, _), rest = pts[0], pts[1:]
+    for b in rest:
+        bx, by = b[0], b[1]
+        dx, dy = bx - ax, by - ay
         length2 = dx * dx + dy * dy
-        for (x, y), out in ((p, to_p), (q, to_q)) if to_p else ((p, to_p),):
-            px, py = x - a[0], y - a[1]
+        for (x, y), out in pairs:
+            px, py = x - ax, y - ay
             t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
             t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
             out.append(math.hypot(px - t * dx, py - t * dy))
-        a = b
+        pairs, ax, ay = ((p, to_p), (q, to_q)), bx, by
     return to_p, to_q
 
 
