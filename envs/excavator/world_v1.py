@@ -225,7 +225,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
         # radius it contains the box (its bound may then rule the bucket out).
         along_half = 0.5 * (m.L4 + 0.2)  # bodies.bucket_box: -0.15 to L4 + 0.05 along u
         contain = math.sqrt(along_half**2 + half[1] ** 2 + half[2] ** 2)
-        self._sphere_slack = {"bucket": contain - self._bucket_sphere[2] + 1e-9, "house": 0.0}
+        self._bucket_slack = contain - self._bucket_sphere[2] + 1e-9
+        self._sphere_slack = {"bucket": self._bucket_slack, "house": 0.0}
         self._swing_axis, self._up = bodies.swing_axis(self.rotation, m.L0)
         origin = ((0.0, 0.0, 0.0),) * 4  # the tracks do not depend on the arm
         self._tracks_box = bodies.machine_bodies(
@@ -499,8 +500,14 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 if d < best:
                     best = d
             elif d - best < SKIP:
-                for other in ("tracks", "house"):
-                    d = self._exact(cache, name, self._part(cache, other), None, SELF_HORIZON, best)
+                for other in (self._tracks_box, self._part(cache, "house")):
+                    if k == 2:  # the bucket: its sphere's bound first
+                        c, r = self._sphere(cache, "bucket")
+                        d = other.gap(c) - r
+                        if d < SELF_HORIZON and d - self._bucket_slack - best < SKIP:
+                            d = self._box_distance(cache, "bucket", other, SELF_HORIZON, best)
+                    else:
+                        d = self._exact(cache, name, other, None, SELF_HORIZON, best)
                     if d < best:
                         best = d
         return best
@@ -517,15 +524,20 @@ class ExcavatorWorldV1(ExcavatorWorld):
             d = (gap(c) if gap is not None else other.gap(c)) - r
             if d >= horizon or d - self._sphere_slack[name] - best >= SKIP:
                 return d
-            body = self._part(cache, name)
-            d = bodies.lower_bound(body, other)
-            if d >= horizon or d - best >= SKIP:
-                return d
-            return bodies.distance(body, other)
+            return self._box_distance(cache, name, other, horizon, best)
         if isinstance(other, bodies.Box):
             k, pts = PARTS.index(name), self.points
             return bodies.segment_to_box(pts[k], pts[k + 1], other, best + REACH[k]) - REACH[k]
         return bodies.distance(self._part(cache, name), other)
+
+    def _box_distance(self, cache: dict, name: str, other, horizon: float, best: float) -> float:
+        """Distance of the bucket's or the house's box to ``other``: the separating axes'
+        bound when not under ``horizon`` (or ``SKIP`` above ``best``), else exact."""
+        body = self._part(cache, name)
+        d = bodies.lower_bound(body, other)
+        if d >= horizon or d - best >= SKIP:
+            return d
+        return bodies.distance(body, other)
 
     def _part(self, cache: dict, name: str):
         if name == "tracks":
