@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from motiongym.envs.excavator.obstacles import segment_box_distance
 from motiongym.envs.geometry import segment_distance
@@ -51,8 +52,10 @@ TRACKS = ((-2.25, 2.25), (-1.5, 1.5), (0.0, 0.92))  # x, y, z (m, frame M)
 # The boom is not checked against the tracks: the straight pin-to-pin line of
 # a bent boom passes where the real boom does not (within the joint limits,
 # the boom's underside meets the ground first, which stops it).
+PART_NAMES = ("boom", "stick", "bucket", "house", "tracks")
 SELF_PAIRS = (("bucket", "tracks"), ("bucket", "house"), ("stick", "tracks"), ("stick", "house"))
 
+SKIP = 1e-9  # m: a lower bound this far above the distance of interest rules a body out
 Vec = tuple[float, float, float]
 
 
@@ -68,9 +71,11 @@ class Capsule:
         return c, 0.5 * math.dist(self.a, self.b) + self.radius
 
 
-@dataclass(frozen=True)
-class Box:
-    """An oriented box: centre, unit axes (rows), half extents (m)."""
+class Box(NamedTuple):
+    """An oriented box: centre, unit axes (rows), half extents (m).
+
+    A named tuple (immutable, compared by value): a step builds a few.
+    """
 
     centre: Vec
     axes: tuple[Vec, Vec, Vec]
@@ -87,11 +92,18 @@ class Box:
 
     def gap(self, p) -> float:
         """Distance from the point ``p`` to the box (0 inside)."""
+        c, (a, b, e), (hx, hy, hz) = self.centre, self.axes, self.half
+        x, y, z = p[0] - c[0], p[1] - c[1], p[2] - c[2]
         total = 0.0
-        for x, h in zip(self.local(p), self.half, strict=True):
-            g = abs(x) - h
-            if g > 0.0:
-                total += g * g
+        g = abs(a[0] * x + a[1] * y + a[2] * z) - hx
+        if g > 0.0:
+            total += g * g
+        g = abs(b[0] * x + b[1] * y + b[2] * z) - hy
+        if g > 0.0:
+            total += g * g
+        g = abs(e[0] * x + e[1] * y + e[2] * z) - hz
+        if g > 0.0:
+            total += g * g
         return math.sqrt(total)
 
     def world(self, u: float, v: float, w: float) -> Vec:
@@ -121,44 +133,93 @@ class Box:
 
 def box_from_ranges(origin: Vec, axes, ranges) -> Box:
     """The box spanning ``ranges`` ((lo, hi) per axis) along ``axes`` from ``origin``."""
-    mid = [0.5 * (lo + hi) for lo, hi in ranges]
-    centre = tuple(origin[i] + sum(mid[k] * axes[k][i] for k in range(3)) for i in range(3))
-    return Box(centre, tuple(tuple(a) for a in axes), tuple(0.5 * (hi - lo) for lo, hi in ranges))
+    (l0, h0), (l1, h1), (l2, h2) = ranges
+    m0, m1, m2 = 0.5 * (l0 + h0), 0.5 * (l1 + h1), 0.5 * (l2 + h2)
+    a, b, c = axes
+    centre = (  # sum() as the reference: the same rounding on every Python
+        origin[0] + sum((m0 * a[0], m1 * b[0], m2 * c[0])),
+        origin[1] + sum((m0 * a[1], m1 * b[1], m2 * c[1])),
+        origin[2] + sum((m0 * a[2], m1 * b[2], m2 * c[2])),
+    )
+    half = (0.5 * (h0 - l0), 0.5 * (h1 - l1), 0.5 * (h2 - l2))
+    return Box(centre, (tuple(a), tuple(b), tuple(c)), half)
 
 
-def segment_to_box(a, b, box: Box) -> float:
-    """Distance from the segment ``a b`` to ``box`` (0 when they meet)."""
-    low = tuple(-h for h in box.half)
-    return segment_box_distance(box.local(a), box.local(b), low, box.half)
+def segment_to_box(a, b, box: Box, above: float = math.inf) -> float:
+    """Distance from the segment ``a b`` to ``box`` (0 when they meet).
+
+    First a lower bound: the gap between the segment's bounding box and the
+    box, in the box's frame (per axis, every point of the segment is at least
+    that far from the box's slab). When it is ``SKIP`` or more above
+    ``above``, the bound is returned instead of the distance.
+    """
+    la, lb, half = box.local(a), box.local(b), box.half
+    if above < math.inf:
+        bound = _aabb_gap(la, lb, half)
+        if bound - above >= SKIP:
+            return bound
+    return segment_box_distance(la, lb, (-half[0], -half[1], -half[2]), half)
 
 
 def separation(p: Box, q: Box) -> float:
     """A lower bound of the distance between two boxes: the widest gap between their
     projections on the six face normals (separating-axis test; <= 0: not separated)."""
-    d = tuple(b - a for a, b in zip(p.centre, q.centre, strict=True))
+    (px, py, pz), (qx, qy, qz) = p.centre, q.centre
+    dx, dy, dz = qx - px, qy - py, qz - pz
+    sides = [(h, a) for box in (p, q) for h, a in zip(box.half, box.axes, strict=True)]
     best = -math.inf
-    for axis in (*p.axes, *q.axes):
-        along = abs(d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2])
-        for box in (p, q):
-            for h, a in zip(box.half, box.axes, strict=True):
-                along -= h * abs(a[0] * axis[0] + a[1] * axis[1] + a[2] * axis[2])
+    for x, y, z in (*p.axes, *q.axes):
+        along = abs(dx * x + dy * y + dz * z)
+        for h, (a, b, c) in sides:
+            along -= h * abs(a * x + b * y + c * z)
         best = along if along > best else best
     return best
 
 
 def box_to_box(p: Box, q: Box) -> float:
-    """Distance between two boxes (0 when they overlap)."""
+    """Distance between two boxes (0 when they overlap).
+
+    The smallest distance from an edge of one box to the other box, both
+    ways. Each box's corners are put in the other's frame once; the edges
+    are visited from the smallest bounding-box bound (as in
+    :func:`segment_to_box`) up, and the visit stops at a bound ``SKIP``
+    above the smallest distance so far (no later edge can be closer).
+    """
     if p.contains(q.centre) or q.contains(p.centre):
         return 0.0
     best = math.inf
     for one, other in ((p, q), (q, p)):
-        for a, b in one.edges():
-            d = segment_to_box(a, b, other)
+        corners = [other.local(c) for c in one.corners()]
+        half = other.half
+        low = (-half[0], -half[1], -half[2])
+        edges = sorted(
+            (_aabb_gap(corners[i], corners[i | bit], half), i, i | bit)
+            for bit in (4, 2, 1)
+            for i in range(8)
+            if not i & bit
+        )
+        for bound, i, j in edges:
+            if bound - best >= SKIP:
+                break
+            d = segment_box_distance(corners[i], corners[j], low, half)
             if d < best:
                 best = d
                 if d == 0.0:
                     return 0.0
     return best
+
+
+def _aabb_gap(a: Vec, b: Vec, half: Vec) -> float:
+    """Distance from the segment ``a b``'s bounding box to the box ``[-half, half]``
+    (one frame): a lower bound of the segment's distance to that box."""
+    total = 0.0
+    for p, q, h in ((a[0], b[0], half[0]), (a[1], b[1], half[1]), (a[2], b[2], half[2])):
+        g = (p if p < q else q) - h
+        if g <= 0.0:
+            g = -h - (q if p < q else p)
+        if g > 0.0:
+            total += g * g
+    return math.sqrt(total)
 
 
 def lower_bound(p, q) -> float:
@@ -213,22 +274,42 @@ def machine_bodies(
     ``names`` (default: all five) selects the parts built.
     """
     foot, stick_pin, pin, tip = points
-    c1, s1 = math.cos(swing), math.sin(swing)
     rot = _apply(rotation)
-    up, axis = rot((0.0, 0.0, 1.0)), rot((-L0, 0.0, 0.0))  # where the swing axis meets the ground
-    build = {
-        "boom": lambda: Capsule(foot, stick_pin, BOOM_RADIUS),
-        "stick": lambda: Capsule(stick_pin, pin, STICK_RADIUS),
-        # The bucket's lateral axis is the joint axis z = (s1, -c1, 0).
-        "bucket": lambda: bucket_box(pin, tip, rot((s1, -c1, 0.0)), bucket_width),
-        "house": lambda: box_from_ranges(
-            axis, (rot((c1, s1, 0.0)), rot((-s1, c1, 0.0)), up), HOUSE
-        ),
-        "tracks": lambda: box_from_ranges(
-            axis, (rot((1.0, 0.0, 0.0)), rot((0.0, 1.0, 0.0)), up), TRACKS
-        ),
-    }
-    return {name: build[name]() for name in (names or build)}
+    axis, up = swing_axis(rotation, L0)
+    out = {}
+    for name in names or PART_NAMES:
+        if name == "boom":
+            out[name] = Capsule(foot, stick_pin, BOOM_RADIUS)
+        elif name == "stick":
+            out[name] = Capsule(stick_pin, pin, STICK_RADIUS)
+        elif name == "bucket":  # the lateral axis is the joint axis z = (s1, -c1, 0)
+            lateral = rot((math.sin(swing), -math.cos(swing), 0.0))
+            out[name] = bucket_box(pin, tip, lateral, bucket_width)
+        elif name == "house":
+            out[name] = house_box(axis, up, math.cos(swing), math.sin(swing), rotation)
+        else:
+            out[name] = box_from_ranges(
+                axis, (rot((1.0, 0.0, 0.0)), rot((0.0, 1.0, 0.0)), up), TRACKS
+            )
+    return out
+
+
+def swing_axis(rotation, L0: float) -> tuple[Vec, Vec]:
+    """Where the swing axis meets the ground (``x = -L0`` in M) and the base's z, in frame O."""
+    rot = _apply(rotation)
+    return rot((-L0, 0.0, 0.0)), rot((0.0, 0.0, 1.0))
+
+
+def house_box(axis: Vec, up: Vec, c1: float, s1: float, rotation) -> Box:
+    """The house's body at the swing angle of cosine ``c1`` and sine ``s1``; ``axis``
+    and ``up`` as :func:`swing_axis` gives them, ``rotation`` as in :func:`machine_bodies`."""
+    if rotation is None:
+        ahead, side = (c1, s1, 0.0), (-s1, c1, 0.0)
+    else:  # R (c1, s1, 0) and R (-s1, c1, 0), as _apply
+        (a, b, c), (d, e, f), (g, h, i) = rotation
+        ahead = (a * c1 + b * s1 + c * 0.0, d * c1 + e * s1 + f * 0.0, g * c1 + h * s1 + i * 0.0)
+        side = (a * -s1 + b * c1 + c * 0.0, d * -s1 + e * c1 + f * 0.0, g * -s1 + h * c1 + i * 0.0)
+    return box_from_ranges(axis, (ahead, side, up), HOUSE)
 
 
 def _apply(rotation):

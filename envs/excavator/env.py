@@ -8,6 +8,7 @@ Both wire a world (:class:`.world.ExcavatorWorld`, physics "v0", or
 
 from __future__ import annotations
 
+import math
 import struct
 from functools import partial
 from typing import Any
@@ -169,12 +170,17 @@ class ExcavatorBase(NeedsReset, Renders, gym.Env):
         return self._renderer.render(self.world)
 
 
+_FLOAT32 = np.dtype(np.float32)
 _ACTION_SPACE = "Box(-1.0, 1.0, (4,), float32): swing, boom, stick, bucket rates"
 
 
 def _checked_action(action: Any) -> list[float]:
     """The action as 4 floats: real numbers only (no complex, text or objects), shape
     (4,), finite; values outside [-1, 1] are clipped by the world (Box convention)."""
+    if type(action) is np.ndarray and action.dtype == _FLOAT32 and action.shape == (4,):
+        values = action.tolist()  # the space's own type: the checks below in short
+        if math.isfinite(values[0] + values[1] + values[2] + values[3]):
+            return values
     kind = np.asarray(action).dtype.kind if not isinstance(action, str) else "U"
     if kind not in "biuf":
         raise ArgumentError(f"action must be an array in {_ACTION_SPACE}, got {action!r}")

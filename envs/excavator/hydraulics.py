@@ -25,16 +25,21 @@ from __future__ import annotations
 
 
 def hydraulic_rates(values, qdot, m, dt: float) -> list[float]:
-    """Joint rates (rad/s) after the pump-flow and acceleration limits (see the module)."""
-    cmd = [
-        (1.0 if v > 1.0 else -1.0 if v < -1.0 else v) * r
-        for v, r in zip(values, m.rate_max, strict=True)
-    ]
-    demand = sum(abs(c) / r * s for c, r, s in zip(cmd, m.rate_max, m.pump_share, strict=True))
+    """Joint rates (rad/s) after the pump-flow and acceleration limits (see the module).
+
+    Written out for the four functions: a step calls it once.
+    """
+    (r0, r1, r2, r3), (s0, s1, s2, s3) = m.rate_max, m.pump_share
+    v0, v1, v2, v3 = values
+    c0 = (1.0 if v0 > 1.0 else -1.0 if v0 < -1.0 else v0) * r0
+    c1 = (1.0 if v1 > 1.0 else -1.0 if v1 < -1.0 else v1) * r1
+    c2 = (1.0 if v2 > 1.0 else -1.0 if v2 < -1.0 else v2) * r2
+    c3 = (1.0 if v3 > 1.0 else -1.0 if v3 < -1.0 else v3) * r3
+    demand = sum((abs(c0) / r0 * s0, abs(c1) / r1 * s1, abs(c2) / r2 * s2, abs(c3) / r3 * s3))
     if demand > 1.0:
-        cmd = [c / demand for c in cmd]
+        c0, c1, c2, c3 = c0 / demand, c1 / demand, c2 / demand, c3 / demand
     out = []
-    for c, w, a in zip(cmd, qdot, m.accel_max, strict=True):
+    for c, w, a in zip((c0, c1, c2, c3), qdot, m.accel_max, strict=True):
         step = a * dt
         out.append(w + step if c - w > step else w - step if w - c > step else c)
     return out

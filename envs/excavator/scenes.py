@@ -120,7 +120,8 @@ def _tilt(scene_parts: tuple, base: tuple[float, float, float]):
     if base == (0.0, 0.0, 0.0):
         return heights, pipe, truck
     gx, gy = ground_plane(base)
-    heights = heights + gx * CELL_XS[:, None] + gy * CELL_YS[None, :]
+    if heights is not None:
+        heights = heights + gx * CELL_XS[:, None] + gy * CELL_YS[None, :]
     if pipe is not None:
         a, b = pipe.a, pipe.b
         pipe = Pipe(
@@ -247,7 +248,7 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
         depth = min(pipe.a[2], tip[2] - 1.0 - pipe.radius)
         pipe = Pipe(a=(*pipe.a[:2], depth), b=(*pipe.b[:2], depth), radius=pipe.radius)
     else:  # laid on the plane, then lowered until all of it is 1 m below the tip
-        _, pipe, _ = _tilt((heights, pipe, truck), base)
+        _, pipe, _ = _tilt((None, pipe, None), base)
         drop = max(pipe.a[2], pipe.b[2]) - (tip[2] - 1.0 - pipe.radius)
         if drop > 0.0:
             a, b = pipe.a, pipe.b

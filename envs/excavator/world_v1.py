@@ -42,7 +42,14 @@ from motiongym.envs.excavator import bodies
 from motiongym.envs.excavator.digging import DEPTH_TOLERANCE, PUSH, cuts, stall_fraction
 from motiongym.envs.excavator.hydraulics import hydraulic_rates
 from motiongym.envs.excavator.kinematics import arm_points, base_rotation
-from motiongym.envs.excavator.scenes import CELL_XS, CELL_YS, ground_plane
+from motiongym.envs.excavator.scenes import (
+    CELL_XS,
+    CELL_YS,
+    GRID_CELL,
+    GRID_ORIGIN,
+    GRID_SHAPE,
+    ground_plane,
+)
 from motiongym.envs.excavator.soil import cutting_force
 from motiongym.envs.excavator.world import HORIZON, POUR_NZ, POUR_TIME, ExcavatorWorld
 
@@ -54,6 +61,8 @@ HOUSE_RADIUS = 3.5  # m: house and tracks lie within this of the swing axis (3.1
 # The bucket shell's underside in the bucket frame: (fraction of L4 along u, m behind the opening).
 SHELL = ((0.0, 0.75), (0.6, 0.9), (0.85, 0.55))
 SHELL_INSET = 0.1  # m: shell points this far inside the side plates (one cell of the map)
+REACH = (bodies.BOOM_RADIUS, bodies.STICK_RADIUS, UNDER_REACH)  # each part's from its segment
+SKIP = bodies.SKIP  # m: a bound this far above the smallest clearance so far leaves its part out
 
 
 class Pose:
@@ -71,50 +80,66 @@ class Pose:
         "n",
         "u",
         "lat",
-        "edge",
         "low_arm",
         "low_edge",
         "_world",
+        "c1",
+        "s1",
+        "edge_memo",
+        "body_memo",
     )
 
     def __init__(self, q, world) -> None:
         self.q, self._world = q, world
+        # (terrain, its version, depth): the exact depths below, kept while the ground stays.
+        self.edge_memo = self.body_memo = (None, -1, 0.0)
         m, r = world.m, world.rotation
         q1, q2, q3, q4 = q
         pts = arm_points(q1, q2, q3, q4, m)
-        c1, s1 = math.cos(q1), math.sin(q1)
+        self.c1, self.s1 = c1, s1 = math.cos(q1), math.sin(q1)
         beta = q2 + q3 + q4
         cb, sb = math.cos(beta), math.sin(beta)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
-        if r is not None:
+        if r is not None:  # R v for each point and axis
             (a, b, c), (d, e, f), (g, h, i) = r
-            pts, n, u, lat = (
-                tuple(
+            pts = tuple(
+                [
                     (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-                    for x, y, z in vectors
-                )
-                for vectors in (pts, (n,), (u,), (lat,))
+                    for x, y, z in pts
+                ]
             )
-            n, u, lat = n[0], u[0], lat[0]
+            (x, y, z), (x1, y1, z1) = n, u
+            n = (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+            u = (a * x1 + b * y1 + c * z1, d * x1 + e * y1 + f * z1, g * x1 + h * y1 + i * z1)
+            x, y = s1, -c1
+            lat = (a * x + b * y + c * 0.0, d * x + e * y + f * 0.0, g * x + h * y + i * 0.0)
         self.points, self.tip, self.beta = pts, pts[3], beta
         self.n, self.u, self.lat = n, u, lat
-        tip, half = pts[3], 0.5 * m.bucket_width - 0.05
+        tip, half = pts[3], world._edge_half
         lx, ly, lz = half * lat[0], half * lat[1], half * lat[2]
-        self.edge = (
+        # Heights above the ground plane: of the lowest arm point past the foot, and the edge.
+        gx, gy = world._gx, world._gy
+        _, (x1, y1, z1), (x2, y2, z2), (x3, y3, z3) = pts
+        h1, h2, h3 = z1 - gx * x1 - gy * y1, z2 - gx * x2 - gy * y2, z3 - gx * x3 - gy * y3
+        low = h2 if h2 < h1 else h1
+        self.low_arm = h3 if h3 < low else low
+        self.low_edge = tip[2] - gx * tip[0] - gy * tip[1] - abs(lz) - abs(gx * lx + gy * ly)
+
+    def edge(self) -> tuple[tuple[float, float, float], ...]:
+        """The cutting edge's two ends and its middle (the tip), O."""
+        tip, half, lat = self.tip, self._world._edge_half, self.lat
+        lx, ly, lz = half * lat[0], half * lat[1], half * lat[2]
+        return (
             (tip[0] + lx, tip[1] + ly, tip[2] + lz),
             tip,
             (tip[0] - lx, tip[1] - ly, tip[2] - lz),
         )
-        # Heights above the ground plane: of the lowest arm point past the foot, and the edge.
-        gx, gy = world._gx, world._gy
-        self.low_arm = min(p[2] - gx * p[0] - gy * p[1] for p in pts[1:])
-        self.low_edge = tip[2] - gx * tip[0] - gy * tip[1] - abs(lz) - abs(gx * lx + gy * ly)
 
     def under(self) -> list[tuple[float, float, float]]:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
         world = self._world
         m, rot = world.m, world._rot if world.rotation is not None else None
-        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
+        c1, s1 = self.c1, self.s1
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
         out = [
             (x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0)
@@ -157,6 +182,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._truck_centre = (truck.cx, truck.cy)
         self._truck_radius = math.hypot(truck.half_length, truck.half_width)
         self._axis = (-self.m.L0, 0.0)
+        self._limits = tuple((lo, hi) for _, _, lo, hi in self._joints)
+        self._edge_half = 0.5 * self.m.bucket_width - 0.05  # the edge's half-width past the plates
         # The house stays within HOUSE_RADIUS of the axis: its bound to the truck is fixed.
         self._house_truck = (
             math.hypot(truck.cx + self.m.L0, truck.cy) - self._truck_radius - HOUSE_RADIUS
@@ -179,9 +206,28 @@ class ExcavatorWorldV1(ExcavatorWorld):
         # + 0.01 m: the plane's change within a cell (the map holds cell centres).
         self._relief_max = float((scene.heights - self._plane).max()) + 0.01
         tilt = math.hypot(self._gx, self._gy)
+        # The plane's change from a cell's centre to its corners, and the map's extent.
+        self._cell_tilt = 0.5 * GRID_CELL * (abs(self._gx) + abs(self._gy)) + SKIP
+        nx, ny = GRID_SHAPE
+        self._map_xy = (
+            (GRID_ORIGIN[0], GRID_ORIGIN[0] + nx * GRID_CELL),
+            (GRID_ORIGIN[1], GRID_ORIGIN[1] + ny * GRID_CELL),
+        )
         self._house_relief = bodies.HOUSE[2][0] - 3.0 * tilt
         half = [0.5 * (hi - lo) for lo, hi in bodies.HOUSE]
         self._house_radius = math.sqrt(sum(h * h for h in half))
+        self._house_mid = tuple(0.5 * (lo + hi) for lo, hi in bodies.HOUSE)
+        m = self.m
+        along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
+        half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
+        self._bucket_sphere = along, back, math.sqrt(sum(h * h for h in half))
+        # That sphere misses the box's 0.05 m beyond the bucket pin; with this much more
+        # radius it contains the box (its bound may then rule the bucket out).
+        along_half = 0.5 * (m.L4 + 0.2)  # bodies.bucket_box: -0.15 to L4 + 0.05 along u
+        contain = math.sqrt(along_half**2 + half[1] ** 2 + half[2] ** 2)
+        self._bucket_slack = contain - self._bucket_sphere[2] + 1e-9
+        self._sphere_slack = {"bucket": self._bucket_slack, "house": 0.0}
+        self._swing_axis, self._up = bodies.swing_axis(self.rotation, m.L0)
         origin = ((0.0, 0.0, 0.0),) * 4  # the tracks do not depend on the arm
         self._tracks_box = bodies.machine_bodies(
             origin, 0.0, self.rotation, self.m.bucket_width, self.m.L0, ("tracks",)
@@ -191,33 +237,27 @@ class ExcavatorWorldV1(ExcavatorWorld):
     # ------------------------------------------------------------------ step
     def advance(self, values: list[float]) -> None:
         m, dt = self.m, self.dt
-        q0 = list(self.q)
+        q0 = self.q
         rates = hydraulic_rates(values, self.qdot, m, dt)
         target = []
-        for (k, _, lo, hi), r in zip(self._joints, rates, strict=True):
-            new = q0[k] + r * dt
+        for a, r, (lo, hi) in zip(q0, rates, self._limits, strict=True):
+            new = a + r * dt
             target.append(lo if new < lo else hi if new > hi else new)
-        pose0, pose1 = self._pose_now, self._pose(target)
-        v = tuple(b - a for a, b in zip(pose0.tip, pose1.tip, strict=True))
+        pose0, pose1 = self._pose_now, Pose(target, self)
         depth1 = self._edge_depth(pose1)
-        cutting = self.carve and depth1 > 0.0 and cuts(v, pose1.n)
-        edge0, body0 = self._edge_depth(pose0), self._penetration(pose0)
-
-        def free(pose: Pose) -> bool:
-            # Into the ground only where a part is not yet, or on its way out.
-            body = self._penetration(pose)
-            if body > DEPTH_TOLERANCE and body >= body0:
-                return False
-            if cutting:
-                return True
-            edge = self._edge_depth(pose)
-            return edge <= DEPTH_TOLERANCE or edge < edge0
-
-        t, pose = 1.0, pose1
+        cutting = False
+        if self.carve and depth1 > 0.0:
+            tip0, tip1 = pose0.tip, pose1.tip
+            v = (tip1[0] - tip0[0], tip1[1] - tip0[1], tip1[2] - tip0[2])
+            cutting = cuts(v, pose1.n)
+        # The pose's ground tests (free, below), with the old pose's depths read only when needed.
         body1 = self._penetration(pose1)
-        body_stop = body1 > DEPTH_TOLERANCE and body1 >= body0
-        if body_stop or not free(pose1):
-            t, pose = self._bisect(q0, target, free)
+        body_stop = body1 > DEPTH_TOLERANCE and body1 >= self._penetration(pose0)
+        t, pose = 1.0, pose1
+        if body_stop or not (
+            cutting or depth1 <= DEPTH_TOLERANCE or depth1 < self._edge_depth(pose0)
+        ):
+            t, pose = self._bisect(q0, target, self._free(pose0, cutting))
         self.cut_force = cutting_force(depth1, m.bucket_width, m) if cutting else 0.0
         if cutting:
             f = stall_fraction(self.cut_force, m.dig_force)
@@ -225,8 +265,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 t, pose = f, self._pose(_lerp(q0, target, f))
         self.ground_contact = 1.0 if body_stop else 0.0
         self.advance_fraction = t
-        self.q = list(pose.q)
-        self.qdot = [(a - b) / dt for a, b in zip(self.q, q0, strict=True)]
+        self.q = q = list(pose.q)
+        self.qdot = [(a - b) / dt for a, b in zip(q, q0, strict=True)]
         self._set_pose(pose)
         self.steps += 1
         self.elapsed = self.steps * dt
@@ -236,6 +276,22 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 self._cut(pose0, pose)
             self._pour_if_tipped()
         self._clearances()
+
+    def _free(self, pose0: Pose, cutting: bool):
+        """The test of a pose reached from ``pose0``: into the ground only where a part
+        is not yet, or on its way out (the edge: or while it cuts)."""
+        edge0, body0 = self._edge_depth(pose0), self._penetration(pose0)
+
+        def free(pose: Pose) -> bool:
+            body = self._penetration(pose)
+            if body > DEPTH_TOLERANCE and body >= body0:
+                return False
+            if cutting:
+                return True
+            edge = self._edge_depth(pose)
+            return edge <= DEPTH_TOLERANCE or edge < edge0
+
+        return free
 
     def _bisect(self, q0, target, free) -> tuple[float, Pose]:
         """The largest fraction of the step (to 1/64) whose pose is ``free``."""
@@ -296,22 +352,46 @@ class ExcavatorWorldV1(ExcavatorWorld):
         gap = pose.low_edge - self._relief_max
         if gap > 0.0:
             return -gap
-        h = self.terrain.height_at
-        return max(h(p[0], p[1]) - p[2] for p in pose.edge)
+        t = self.terrain
+        memo = pose.edge_memo
+        if memo[0] is t and memo[1] == t.version:
+            return memo[2]
+        h = t.height_at
+        depth = max(h(p[0], p[1]) - p[2] for p in pose.edge())
+        pose.edge_memo = (t, t.version, depth)
+        return depth
 
     def _penetration(self, pose: Pose) -> float:
-        """Deepest point of the bodies' undersides below the ground (m; negative: above).
+        """Deepest point of the bodies' undersides below the ground (m; negative: above),
+        exact where it matters: over ``DEPTH_TOLERANCE``, else a value not over it.
 
         The undersides lie at most ``UNDER_REACH`` below the arm points and the
         house's corners at least ``0.95 - 3 tan(tilt)`` above the plane: above
-        the highest relief by more, a negative bound is returned.
+        the highest relief by more, a negative bound is returned. A point that
+        the relief bound alone keeps out of that tolerance is not looked up in
+        the map (its bound stands for it: the steps' ground tests compare a
+        depth with the tolerance, and two depths only when one is over it).
         """
         low = pose.low_arm - UNDER_REACH
         gap = (low if low < self._house_relief else self._house_relief) - self._relief_max
         if gap > 0.0:
             return -gap
-        h = self.terrain.height_at
-        return max(h(p[0], p[1]) - p[2] for p in pose.under())
+        t = self.terrain
+        memo = pose.body_memo
+        if memo[0] is t and memo[1] == t.version:
+            return memo[2]
+        h, gx, gy = t.height_at, self._gx, self._gy
+        relief = self._relief_max + self._cell_tilt  # over the plane anywhere in a cell
+        (x0, x1), (y0, y1) = self._map_xy
+        depth = -math.inf
+        for x, y, z in pose.under():
+            d = relief + gx * x + gy * y - z
+            if d > DEPTH_TOLERANCE - SKIP or not (x0 < x < x1 and y0 < y < y1):
+                d = h(x, y) - z
+            if d > depth:
+                depth = d
+        pose.body_memo = (t, t.version, depth)
+        return depth
 
     def _deposit(self, x: float, y: float, volume: float) -> None:
         """Soil on the ground at ``(x, y)``; the relief bound follows."""
@@ -327,8 +407,8 @@ class ExcavatorWorldV1(ExcavatorWorld):
     def _cut(self, pose0: Pose, pose1: Pose) -> None:
         """Carve the edge's sweep; the bucket takes what it holds, the rest is pushed ahead."""
         m = self.m
-        e0 = ((pose0.edge[0][0], pose0.edge[0][1]), (pose0.edge[2][0], pose0.edge[2][1]))
-        e1 = ((pose1.edge[0][0], pose1.edge[0][1]), (pose1.edge[2][0], pose1.edge[2][1]))
+        (a0, _, b0), (a1, _, b1) = pose0.edge(), pose1.edge()
+        e0, e1 = ((a0[0], a0[1]), (b0[0], b0[1])), ((a1[0], a1[1]), (b1[0], b1[1]))
         removed = self.terrain.carve(e0, e1, pose0.tip[2], pose1.tip[2], math.inf)
         if removed <= 0.0:
             return
@@ -365,64 +445,111 @@ class ExcavatorWorldV1(ExcavatorWorld):
         link's within its radius; house and tracks within ``HOUSE_RADIUS``
         of the swing axis) against the obstacle's bounding circle in plan
         and its top; the bucket's bounding sphere next; a body is built only
-        when its bound is under its horizon.
+        when its bound is under its horizon. A clearance is the smallest of
+        these values; a part whose bound (``SKIP`` above it to cover
+        rounding) is not below the smallest so far cannot change it and is
+        left out: the values are those of computing every part.
         """
         pts = self.points
-        reach = (bodies.BOOM_RADIUS, bodies.STICK_RADIUS, UNDER_REACH)
+        z0, z1, z2, z3 = pts[0][2], pts[1][2], pts[2][2], pts[3][2]
+        lows = (z1 if z1 < z0 else z0, z2 if z2 < z1 else z1, z3 if z3 < z2 else z2)
         cache: dict = {}
-        best = math.inf
-        for k, name in enumerate(PARTS):
-            d = min(pts[k][2], pts[k + 1][2]) - reach[k] - self._pipe_top
-            if d < HORIZON:
-                d = self._exact(cache, name, self._pipe_body, self._pipe_gap, HORIZON)
-            best = d if d < best else best
-        self.pipe_clear = best
-        cx, cy = self._truck_centre
-        best = self._house_truck
-        if best < SELF_HORIZON:
-            best = self._exact(cache, "house", self._truck_body, self._truck_body.gap, SELF_HORIZON)
-        for k, name in enumerate(PARTS):
-            plan = _plan_gap(pts[k], pts[k + 1], cx, cy) - self._truck_radius
-            above = min(pts[k][2], pts[k + 1][2]) - self.truck.height
-            d = max(plan, above) - reach[k]
-            if d < HORIZON:
-                d = self._exact(cache, name, self._truck_body, self._truck_body.gap, HORIZON)
-            best = d if d < best else best
-        self.truck_clear = best
-        ax, ay = self._axis
-        best = math.inf
-        for k, name in ((1, "stick"), (2, "bucket")):
-            plan = _plan_gap(pts[k], pts[k + 1], ax, ay) - HOUSE_RADIUS
-            above = min(pts[k][2], pts[k + 1][2]) - self._house_top
-            d = max(plan, above) - reach[k]
-            if d < SELF_HORIZON:
-                d = min(
-                    self._exact(cache, name, self._part(cache, other), None, SELF_HORIZON)
-                    for other in ("tracks", "house")
-                )
-            best = d if d < best else best
-        self.self_clear = best
+        to_truck, to_axis = _plan_gaps(pts, self._truck_centre, self._axis)
+        self.pipe_clear = self._pipe_clearance(cache, lows)
+        self.truck_clear = self._truck_clearance(cache, lows, to_truck)
+        self.self_clear = self._self_clearance(cache, lows, to_axis)
 
-    def _exact(self, cache: dict, name: str, other, gap, horizon: float) -> float:
+    def _pipe_clearance(self, cache: dict, lows) -> float:
+        top = self._pipe_top
+        d0, d1, d2 = lows[0] - REACH[0] - top, lows[1] - REACH[1] - top, lows[2] - REACH[2] - top
+        if d0 >= HORIZON and d1 >= HORIZON and d2 >= HORIZON:  # far: the bounds stand
+            return min(d0, d1, d2)
+        best = math.inf
+        for k, name in enumerate(PARTS):
+            d = lows[k] - REACH[k] - top
+            if d < HORIZON:
+                if d - best >= SKIP:
+                    continue
+                d = self._exact(cache, name, self._pipe_body, self._pipe_gap, HORIZON, best)
+            if d < best:
+                best = d
+        return best
+
+    def _truck_clearance(self, cache: dict, lows, plan) -> float:
+        box, best = self._truck_body, self._house_truck
+        if best < SELF_HORIZON:
+            best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
+        radius, height = self._truck_radius, self.truck.height
+        for k, name in enumerate(PARTS):
+            gap, above = plan[k] - radius, lows[k] - height
+            d = (above if above > gap else gap) - REACH[k]
+            if d < HORIZON:
+                if d - best >= SKIP:
+                    continue
+                d = self._exact(cache, name, box, box.gap, HORIZON, best)
+            if d < best:
+                best = d
+        return best
+
+    def _self_clearance(self, cache: dict, lows, plan) -> float:
+        best, top = math.inf, self._house_top
+        for k, name in ((2, "bucket"), (1, "stick")):  # the bucket's cheap bounds first
+            gap, above = plan[k - 1] - HOUSE_RADIUS, lows[k] - top
+            d = (above if above > gap else gap) - REACH[k]
+            if d >= SELF_HORIZON:
+                if d < best:
+                    best = d
+            elif d - best < SKIP:
+                for other in (self._tracks_box, self._part(cache, "house")):
+                    if k == 2:  # the bucket: its sphere's bound first
+                        c, r = self._sphere(cache, "bucket")
+                        d = other.gap(c) - r
+                        if d < SELF_HORIZON and d - self._bucket_slack - best < SKIP:
+                            d = self._box_distance(cache, "bucket", other, SELF_HORIZON, best)
+                    else:
+                        d = self._exact(cache, name, other, None, SELF_HORIZON, best)
+                    if d < best:
+                        best = d
+        return best
+
+    def _exact(self, cache: dict, name: str, other, gap, horizon: float, best=math.inf) -> float:
         """Distance of part ``name`` to ``other``; for a box, its sphere's and its
-        separating axes' bounds first (the bound is returned when not under ``horizon``)."""
+        separating axes' bounds first (the bound is returned when not under ``horizon``).
+
+        A bound ``SKIP`` or more above ``best`` is returned as it is (the
+        distance, not smaller, would not be the smallest either).
+        """
         if name == "bucket" or name == "house":
-            c, r = self._sphere(name)
+            c, r = self._sphere(cache, name)
             d = (gap(c) if gap is not None else other.gap(c)) - r
-            if d >= horizon:
+            if d >= horizon or d - self._sphere_slack[name] - best >= SKIP:
                 return d
-            body = self._part(cache, name)
-            d = bodies.lower_bound(body, other)
-            if d >= horizon:
-                return d
-            return bodies.distance(body, other)
+            return self._box_distance(cache, name, other, horizon, best)
+        if isinstance(other, bodies.Box):
+            k, pts = PARTS.index(name), self.points
+            return bodies.segment_to_box(pts[k], pts[k + 1], other, best + REACH[k]) - REACH[k]
         return bodies.distance(self._part(cache, name), other)
+
+    def _box_distance(self, cache: dict, name: str, other, horizon: float, best: float) -> float:
+        """Distance of the bucket's or the house's box to ``other``: the separating axes'
+        bound when not under ``horizon`` (or ``SKIP`` above ``best``), else exact."""
+        body = self._part(cache, name)
+        d = bodies.lower_bound(body, other)
+        if d >= horizon or d - best >= SKIP:
+            return d
+        return bodies.distance(body, other)
 
     def _part(self, cache: dict, name: str):
         if name == "tracks":
             return self._tracks_box
         if name not in cache:
-            cache.update(self._bodies((name,)))
+            if name == "house":
+                pose = self._pose_now
+                cache[name] = bodies.house_box(
+                    self._swing_axis, self._up, pose.c1, pose.s1, self.rotation
+                )
+            else:
+                cache.update(self._bodies((name,)))
         return cache[name]
 
     def _pipe_gap(self, c) -> float:
@@ -439,44 +566,53 @@ class ExcavatorWorldV1(ExcavatorWorld):
             self.points, self.q[0], self.rotation, self.m.bucket_width, self.m.L0, names
         )
 
-    def _sphere(self, name: str) -> tuple[tuple[float, float, float], float]:
+    def _sphere(self, cache: dict, name: str) -> tuple[tuple[float, float, float], float]:
         """Bounding sphere ``(centre, radius)`` of the bucket's or the house's body."""
-        m = self.m
+        key = _SPHERE_KEYS[name]
+        if key in cache:
+            return cache[key]
         if name == "bucket":
             pin, pose = self.points[2], self._pose_now
-            along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
+            along, back, radius = self._bucket_sphere
             u, n = pose.u, pose.n
-            centre = tuple(pin[i] + along * u[i] - back * n[i] for i in range(3))
-            half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
-            return centre, math.sqrt(sum(h * h for h in half))
-        c1, s1 = math.cos(self.q[0]), math.sin(self.q[0])
-        (x0, x1), (y0, y1), (z0, z1) = bodies.HOUSE
-        x, y = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-        house = (-m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, 0.5 * (z0 + z1))
-        return (self._rot(house) if self.rotation else house), self._house_radius
+            centre = (
+                pin[0] + along * u[0] - back * n[0],
+                pin[1] + along * u[1] - back * n[1],
+                pin[2] + along * u[2] - back * n[2],
+            )
+            cache[key] = centre, radius
+            return cache[key]
+        c1, s1 = self._pose_now.c1, self._pose_now.s1
+        x, y, z = self._house_mid
+        house = (-self.m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, z)
+        if self.rotation:
+            (a, b, c), (d, e, f), (g, h, i) = self.rotation
+            x, y, z = house
+            house = (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+        cache[key] = house, self._house_radius
+        return cache[key]
 
 
-def _plan_gap(a, b, x: float, y: float) -> float:
-    """Plan-view distance from the point ``(x, y)`` to the segment ``a b``."""
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    px, py = x - a[0], y - a[1]
-    length2 = dx * dx + dy * dy
-    t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
-    t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-    return math.hypot(px - t * dx, py - t * dy)
+_SPHERE_KEYS = {"bucket": "bucket sphere", "house": "house sphere"}  # in a step's cache
 
 
-def _mid(a, b) -> tuple[float, float, float]:
-    return (0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]))
-
-
-def _near(body, other) -> float:
-    """Exact distance when under ``HORIZON``, else a lower bound from ``body``'s sphere."""
-    centre, radius = body.sphere()
-    bound = bodies.distance(bodies.Capsule(centre, centre, radius), other)
-    if bound >= HORIZON:
-        return bound
-    return bodies.distance(body, other)
+def _plan_gaps(pts, p, q) -> tuple[list[float], list[float]]:
+    """Plan-view distances from the point ``p`` to the arm's three segments (boom,
+    stick, bucket) and from ``q`` to the last two."""
+    to_p, to_q = [], []
+    pairs = ((p, to_p),)
+    (ax, ay, _), rest = pts[0], pts[1:]
+    for b in rest:
+        bx, by = b[0], b[1]
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        for (x, y), out in pairs:
+            px, py = x - ax, y - ay
+            t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
+            t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+            out.append(math.hypot(px - t * dx, py - t * dy))
+        pairs, ax, ay = ((p, to_p), (q, to_q)), bx, by
+    return to_p, to_q
 
 
 def _lerp(a, b, t: float) -> list[float]:
