@@ -218,14 +218,12 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._house_radius = math.sqrt(sum(h * h for h in half))
         self._house_mid = tuple(0.5 * (lo + hi) for lo, hi in bodies.HOUSE)
         m = self.m
+        # The bucket's box (bodies.bucket_box): -0.15 to L4 + 0.05 along u, -0.05 to
+        # BUCKET_BACK behind the opening; its bounding sphere about the box's centre.
         along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
-        half = (along + 0.1, back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
+        half = (0.5 * (m.L4 + 0.2), back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
         self._bucket_sphere = along, back, math.sqrt(sum(h * h for h in half))
-        # That sphere misses the box's 0.05 m beyond the bucket pin; with this much more
-        # radius it contains the box (its bound may then rule the bucket out).
-        along_half = 0.5 * (m.L4 + 0.2)  # bodies.bucket_box: -0.15 to L4 + 0.05 along u
-        contain = math.sqrt(along_half**2 + half[1] ** 2 + half[2] ** 2)
-        self._bucket_slack = contain - self._bucket_sphere[2] + 1e-9
+        self._bucket_slack = 1e-9  # rounding: the sphere contains the box
         self._sphere_slack = {"bucket": self._bucket_slack, "house": 0.0}
         self._swing_axis, self._up = bodies.swing_axis(self.rotation, m.L0)
         origin = ((0.0, 0.0, 0.0),) * 4  # the tracks do not depend on the arm

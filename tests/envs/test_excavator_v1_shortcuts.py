@@ -140,3 +140,20 @@ def test_ground_depth_is_exact_over_the_tolerance(relief, slope):
         else:
             assert depth <= DEPTH_TOLERANCE
     assert over > 100
+
+
+@pytest.mark.parametrize("env_id", ["motiongym/Excavator-v1", "motiongym/ExcavatorReach-v1"])
+def test_bounding_spheres_contain_their_boxes(env_id):
+    """The bucket's and the house's spheres (whose gaps stand in for the boxes' distances
+    above a horizon) contain every corner of their boxes, over the joint ranges."""
+    env = gym.make(env_id)
+    world, m = env.unwrapped.world, env.unwrapped.m
+    env.reset(seed=0)
+    for q in np.random.default_rng(4).uniform(m.q_min, m.q_max, size=(300, 4)):
+        world.q = list(q)
+        world._forward()
+        for name in ("bucket", "house"):
+            cache: dict = {}
+            centre, radius = world._sphere(cache, name)
+            corners = world._part(cache, name).corners()
+            assert max(math.dist(centre, c) for c in corners) <= radius + 1e-9, name
