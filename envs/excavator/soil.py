@@ -139,33 +139,10 @@ class Terrain:
         of the patch starting at cell ``(i0, j0)``.
         """
         self.last_cut_depth = 0.0
-        half = 0.5 * self.cell
-        n_u = max(int(math.ceil(math.dist(edge1[0], edge1[1]) / half)), 1)
-        travel = max(math.dist(edge0[0], edge1[0]), math.dist(edge0[1], edge1[1]))
-        n_s = max(int(math.ceil(travel / half)), 1)
-        inv = 1.0 / self.cell
-        xs = (edge0[0][0], edge0[1][0], edge1[0][0], edge1[1][0])
-        ys = (edge0[0][1], edge0[1][1], edge1[0][1], edge1[1][1])
-        i0, i1 = int((min(xs) - self.x0) * inv), int((max(xs) - self.x0) * inv) + 1
-        j0, j1 = int((min(ys) - self.y0) * inv), int((max(ys) - self.y0) * inv) + 1
-        # Most sweeps pass over the ground: nothing is cut when the edge stays
-        # above every cell of the sweep's bounding box (on the map), which
-        # holds every sample's cell.
-        box = self.h[max(i0, 0) : min(i1, self.nx), max(j0, 0) : min(j1, self.ny)]
-        if box.size == 0 or min(z0, z1) - _ROUNDING >= box.max():
+        swept = self._swept_cells(edge0, edge1, z0, z1)
+        if swept is None:
             return 0.0
-        weights, along = _sweep_weights(n_s, n_u)  # (n_s * n_u, 4), (n_s * n_u,)
-        pts = weights @ np.array((edge0[0], edge0[1], edge1[0], edge1[1]))  # (n_s * n_u, 2)
-        zs = z0 + along * (z1 - z0)
-        ij = ((pts - (self.x0, self.y0)) * inv).astype(np.intp)
-        i, j = ij[:, 0], ij[:, 1]
-        if min(xs) < self.x0 or min(ys) < self.y0 or i1 > self.nx or j1 > self.ny:
-            keep = (i >= 0) & (i < self.nx) & (j >= 0) & (j < self.ny)  # partly off the map
-            if not keep.any():
-                return 0.0
-            i, j, zs = i[keep], j[keep], zs[keep]
-            i0, i1 = max(i0, 0), min(i1, self.nx)
-            j0, j1 = max(j0, 0), min(j1, self.ny)
+        i, j, zs, (i0, i1, j0, j1) = swept
         if free_capacity <= 0.0:
             # A full bucket takes nothing (the cut scaled to zero below), so only
             # the depth of cut is needed: the largest ``h - z`` over the samples.
@@ -191,6 +168,45 @@ class Terrain:
         self.last_cut = (i0, j0, cut)
         self.version += 1
         return removed
+
+    def _swept_cells(
+        self,
+        edge0: tuple[np.ndarray, np.ndarray],
+        edge1: tuple[np.ndarray, np.ndarray],
+        z0: float,
+        z1: float,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int, int, int]] | None:
+        """The edge's sweep sampled at half a cell: each sample's cell ``(i, j)`` and
+        height, and the patch ``(i0, i1, j0, j1)`` holding them, clipped to the map;
+        None when the sweep cuts nothing (above its cells, or off the map)."""
+        half = 0.5 * self.cell
+        n_u = max(int(math.ceil(math.dist(edge1[0], edge1[1]) / half)), 1)
+        travel = max(math.dist(edge0[0], edge1[0]), math.dist(edge0[1], edge1[1]))
+        n_s = max(int(math.ceil(travel / half)), 1)
+        inv = 1.0 / self.cell
+        xs = (edge0[0][0], edge0[1][0], edge1[0][0], edge1[1][0])
+        ys = (edge0[0][1], edge0[1][1], edge1[0][1], edge1[1][1])
+        i0, i1 = int((min(xs) - self.x0) * inv), int((max(xs) - self.x0) * inv) + 1
+        j0, j1 = int((min(ys) - self.y0) * inv), int((max(ys) - self.y0) * inv) + 1
+        # Most sweeps pass over the ground: nothing is cut when the edge stays
+        # above every cell of the sweep's bounding box (on the map), which
+        # holds every sample's cell.
+        box = self.h[max(i0, 0) : min(i1, self.nx), max(j0, 0) : min(j1, self.ny)]
+        if box.size == 0 or min(z0, z1) - _ROUNDING >= box.max():
+            return None
+        weights, along = _sweep_weights(n_s, n_u)  # (n_s * n_u, 4), (n_s * n_u,)
+        pts = weights @ np.array((edge0[0], edge0[1], edge1[0], edge1[1]))  # (n_s * n_u, 2)
+        zs = z0 + along * (z1 - z0)
+        ij = ((pts - (self.x0, self.y0)) * inv).astype(np.intp)
+        i, j = ij[:, 0], ij[:, 1]
+        if min(xs) < self.x0 or min(ys) < self.y0 or i1 > self.nx or j1 > self.ny:
+            keep = (i >= 0) & (i < self.nx) & (j >= 0) & (j < self.ny)  # partly off the map
+            if not keep.any():
+                return None
+            i, j, zs = i[keep], j[keep], zs[keep]
+            i0, i1 = max(i0, 0), min(i1, self.nx)
+            j0, j1 = max(j0, 0), min(j1, self.ny)
+        return i, j, zs, (i0, i1, j0, j1)
 
     def deposit(self, x: float, y: float, volume: float, radius: float = 0.5) -> None:
         """Spread ``volume`` (m3) evenly over the cells within ``radius`` of ``(x, y)``."""
