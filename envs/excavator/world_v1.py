@@ -176,6 +176,12 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self.cut_force = 0.0
         self.advance_fraction = 1.0
         self.pushed = 0.0
+        self._obstacle_bounds(scene)
+        self._ground_and_body_bounds(scene, base)
+        super().reset(scene, q0)
+
+    def _obstacle_bounds(self, scene) -> None:
+        """The pipe's and the truck's bodies and the constants of their bounds."""
         pipe, truck = scene.pipe, scene.truck
         self._pipe_body = bodies.Capsule(pipe.a, pipe.b, pipe.radius)
         self._pipe_top = max(pipe.a[2], pipe.b[2]) + pipe.radius
@@ -201,6 +207,10 @@ class ExcavatorWorldV1(ExcavatorWorld):
                 (truck.floor, truck.height),
             ),
         )
+
+    def _ground_and_body_bounds(self, scene, base) -> None:
+        """The ground plane under the base, the relief bound, and the house's, the
+        bucket's and the tracks' fixed bounds."""
         self._gx, self._gy = ground_plane(base)
         self._plane = self._gx * CELL_XS[:, None] + self._gy * CELL_YS[None, :]
         # + 0.01 m: the plane's change within a cell (the map holds cell centres).
@@ -230,7 +240,6 @@ class ExcavatorWorldV1(ExcavatorWorld):
         self._tracks_box = bodies.machine_bodies(
             origin, 0.0, self.rotation, self.m.bucket_width, self.m.L0, ("tracks",)
         )["tracks"]
-        super().reset(scene, q0)
 
     # ------------------------------------------------------------------ step
     def advance(self, values: list[float]) -> None:
