@@ -54,6 +54,7 @@ from motiongym.envs.core import ArgumentError, check_float
 
 # The goal env's own keyword arguments; every other one goes to the base env.
 OWN_KWARGS = ("base", "fields", "collision", "cost")
+ENTRY_POINT = "motiongym.envs.goal:GoalConditionedEnv"
 
 
 @dataclass(frozen=True)
@@ -122,10 +123,22 @@ class GoalFields:
         return flat
 
 
-def load(reference: str) -> Any:
-    """The object named ``"module:attribute"``."""
-    module, name = reference.split(":")
-    return getattr(importlib.import_module(module), name)
+def load(name: str, reference: Any) -> Any:
+    """The object named ``"module:attribute"`` (the argument ``name``), else ArgumentError."""
+    if isinstance(reference, str) and reference.count(":") == 1:
+        module, attribute = reference.split(":")
+        try:
+            return getattr(importlib.import_module(module), attribute)
+        except (ImportError, AttributeError, ValueError, TypeError):
+            pass
+    raise ArgumentError(f"{name} must name an object as 'module:attribute', got {reference!r}")
+
+
+def _check_base(base: Any) -> str:
+    goal_ids = [s.id for s in gym.registry.values() if s.entry_point == ENTRY_POINT]
+    if not isinstance(base, str) or base not in gym.registry or base in goal_ids:
+        raise ArgumentError(f"base must be a registered (non-goal) environment ID, got {base!r}")
+    return base
 
 
 def resolve(env_kwargs: Mapping[str, Any]) -> tuple[str, dict[str, Any], GoalFields]:
@@ -140,18 +153,21 @@ def resolve(env_kwargs: Mapping[str, Any]) -> tuple[str, dict[str, Any], GoalFie
             f"a goal env needs the keyword arguments 'base' (an ID) and 'fields' "
             f"('module:function'), got {sorted(env_kwargs)}"
         )
-    base = env_kwargs["base"]
+    base = _check_base(env_kwargs["base"])
     kwargs = {**gym.spec(base).kwargs}
     kwargs.update({k: v for k, v in env_kwargs.items() if k not in OWN_KWARGS})
     model_kwargs = {k: v for k, v in kwargs.items() if k != "render_mode"}
-    return base, kwargs, load(env_kwargs["fields"])(model_kwargs)
+    fields = load("fields", env_kwargs["fields"])(model_kwargs)
+    if not isinstance(fields, GoalFields):
+        raise ArgumentError(f"fields must return a GoalFields, got {fields!r}")
+    return base, kwargs, fields
 
 
 def goal_registration(base: Mapping[str, Any], goal_id: str, fields: str) -> dict[str, Any]:
     """The registration of ``goal_id``: the goal variant of the registration ``base``."""
     return {
         "id": goal_id,
-        "entry_point": "motiongym.envs.goal:GoalConditionedEnv",
+        "entry_point": ENTRY_POINT,
         "max_episode_steps": base["max_episode_steps"],
         "kwargs": {"base": base["id"], "fields": fields},
     }
@@ -166,9 +182,12 @@ class GoalConditionedEnv(gym.Env):
     ``info["cost"]``); every other keyword goes to the base env.
 
     Observation: ``Dict(observation, achieved_goal, desired_goal)``, float32,
-    bounds the base observation's. Action, ``info``, termination, reset
-    options, rendering: the base env's.
+    bounds the base observation's. ``info``: the base env's, its
+    ``reward_<term>`` replaced by this reward's terms (:meth:`reward_terms`).
+    Action, termination, reset options, rendering: the base env's.
     """
+
+    metadata = {"render_modes": ["rgb_array"]}  # every base's; an instance has its base's
 
     def __init__(self, base: str, fields: str, collision: float = 50.0, cost: float = 0.0, **kw):
         self.collision = check_float("collision", collision, 0.0, 1e6)
@@ -196,13 +215,17 @@ class GoalConditionedEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
         flat, info = self.base.reset(seed=seed, options=options)
-        return self.fields.split(flat), info
+        info = {k: v for k, v in info.items() if not k.startswith("reward_")}
+        names = ("goal", "collision", "cost") if self.collision or self.cost else ("goal",)
+        return self.fields.split(flat), {**info, **{f"reward_{k}": 0.0 for k in names}}
 
     def step(self, action: Any):
         flat, _, terminated, truncated, info = self.base.step(action)
         obs = self.fields.split(flat)
-        reward = self.compute_reward(obs["achieved_goal"], obs["desired_goal"], info)
-        return obs, float(reward), terminated, truncated, info
+        terms = self.reward_terms(obs["achieved_goal"], obs["desired_goal"], info)
+        info = {k: v for k, v in info.items() if not k.startswith("reward_")}
+        info.update({f"reward_{k}": float(v) for k, v in terms.items()})
+        return obs, float(sum(terms.values())), terminated, truncated, info
 
     def render(self):
         return self.base.render()
@@ -239,18 +262,25 @@ class GoalConditionedEnv(gym.Env):
         shape = batch if len(infos) > 1 else ()
         return hit.astype(float).reshape(shape), cost.reshape(shape)
 
+    def reward_terms(self, achieved_goal: Any, desired_goal: Any, info: Any) -> dict[str, Any]:
+        """``goal`` (0 reached, else -1), ``collision`` and ``cost``; they sum to the reward."""
+        a, d = self._goals(achieved_goal, desired_goal)
+        terms = {"goal": self.fields.success(a, d) - 1.0}
+        if self.collision != 0.0 or self.cost != 0.0:
+            hit, cost = self._safety(info, a.shape[:-1])
+            terms["collision"] = -self.collision * hit
+            terms["cost"] = -self.cost * cost
+        return terms
+
     def compute_reward(self, achieved_goal: Any, desired_goal: Any, info: Any) -> Any:
-        """``-1`` unless reached, ``- collision`` on contact, ``- cost * info['cost']``.
+        """The sum of :meth:`reward_terms`: ``-1`` unless reached, ``- collision`` on
+        contact, ``- cost * info['cost']``.
 
         Vectorised: goals (..., g) with ``info`` a dict or an array of dicts
         (one per goal pair); returns a float for one pair, else an array.
         """
-        a, d = self._goals(achieved_goal, desired_goal)
-        reward = self.fields.success(a, d) - 1.0
-        if self.collision != 0.0 or self.cost != 0.0:
-            hit, cost = self._safety(info, a.shape[:-1])
-            reward = reward - self.collision * hit - self.cost * cost
-        return float(reward) if reward.ndim == 0 else reward
+        reward = sum(self.reward_terms(achieved_goal, desired_goal, info).values())
+        return float(reward) if np.ndim(reward) == 0 else reward
 
     def compute_terminated(self, achieved_goal: Any, desired_goal: Any, info: Any) -> Any:
         """Reached, or (where the base ends on it) a collision: as the base terminates."""
