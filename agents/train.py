@@ -113,6 +113,19 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
     )
 
 
+def _check_her(env_id: str, config: dict[str, Any], where: Path) -> None:
+    """HER samples whole episodes: learning must start after the first one can end."""
+    if config.get("replay_buffer_class") != "her":
+        return
+    limit = gym.spec(env_id).max_episode_steps or 0
+    starts = config.get("learning_starts", 100) // config["n_envs"]
+    if starts <= limit:
+        raise UsageError(
+            f"{where}: with replay_buffer_class her, learning_starts / n_envs must exceed "
+            f"{env_id}'s {limit} steps per episode, got {config.get('learning_starts', 100)}"
+        )
+
+
 def _normalize(venv, config: dict[str, Any], training: bool):
     options = config["normalize"]
     if not options:
@@ -158,6 +171,7 @@ def train(
     config = load_config(config_path, algo)
     if n_timesteps is not None:
         config["n_timesteps"] = n_timesteps
+    _check_her(env_id, config, config_path)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
     run_dir.mkdir(parents=True, exist_ok=True)
