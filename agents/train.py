@@ -117,7 +117,7 @@ def _check_her(env_id: str, config: dict[str, Any], where: Path) -> None:
     """HER samples whole episodes: learning must start after the first one can end."""
     if config.get("replay_buffer_class") != "her":
         return
-    limit = gym.spec(env_id).max_episode_steps or 0
+    limit = config["env_kwargs"].get("max_episode_steps", gym.spec(env_id).max_episode_steps) or 0
     starts = config.get("learning_starts", 100) // config["n_envs"]
     if starts <= limit:
         raise UsageError(
