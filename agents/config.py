@@ -36,6 +36,12 @@ replay_buffer_class ``her`` (SB3's ``HerReplayBuffer``, for the goal IDs none
                (``n_sampled_goal``, ``goal_selection_strategy``
                ``future``/``final``/``episode``, ``copy_info_dict``:
                true where the reward reads ``info``)
+residual       a scripted policy's name: train a residual agent          null
+               (:mod:`motiongym.agents.residual`: the env receives
+               that policy's action plus the learned correction);
+               ``vec_env`` dummy or subproc
+residual_scale the correction's range, in (0, 2], as a multiple of   1.0
+               the action bounds
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its
@@ -72,6 +78,8 @@ RUN_SETTINGS: dict[str, Any] = {
     "n_eval_episodes": 5,
     "checkpoint_freq": 50_000,
     "deterministic": True,
+    "residual": None,
+    "residual_scale": 1.0,
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
@@ -228,6 +236,11 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
         for size in layer:
             check_int("net_arch layer size", size, 1, 65_536)
     _check_replay_buffer(config)
+    if config["residual"] is not None and not isinstance(config["residual"], str):
+        raise ArgumentError(
+            f"residual must be a scripted policy's name, got {config['residual']!r}"
+        )
+    check_float("residual_scale", config["residual_scale"], 0.0, 2.0, low_open=True)
     if "log_std_init" in config["policy_kwargs"]:
         check_float("log_std_init", config["policy_kwargs"]["log_std_init"], -20.0, 20.0)
 

@@ -10,7 +10,9 @@ good as ``pi_0`` and learns only what it misses.
 action is the correction ``f``, the environment receives
 ``clip(pi_0(s) + scale * f, low, high)`` (clipped to the action space). The
 observation is unchanged, so SB3 trains the residual with its usual
-algorithms; ``info["base_action"]`` is ``pi_0(s)``.
+algorithms; ``info["base_action"]`` is ``pi_0(s)``. :class:`ResidualPredictor`
+acts the same way outside the wrapper (evaluation of a trained residual
+agent: ``motiongym train`` with ``residual: <policy>`` in the config block).
 """
 
 from __future__ import annotations
@@ -57,7 +59,6 @@ class ResidualWrapper(gym.Wrapper):
         self.scale = check_float("scale", scale, 0.0, 2.0, low_open=True)
         box = env.action_space
         self.action_space = spaces.Box(-1.0, 1.0, box.shape, np.float32)
-        self._half = 0.5 * (box.high - box.low)
         self._obs: Any = None
 
     def reset(self, **kwargs: Any):
@@ -70,7 +71,27 @@ class ResidualWrapper(gym.Wrapper):
         correction = checked_box_action(action, self.action_space.shape, "a correction")
         base, _ = self.policy.predict(self._obs, deterministic=True)
         box = self.env.action_space
-        applied = np.clip(base + self.scale * self._half * correction, box.low, box.high)
+        applied = _combined(base, correction, self.scale, box)
         obs, reward, terminated, truncated, info = self.env.step(applied.astype(box.dtype))
         self._obs = obs
         return obs, reward, terminated, truncated, {**info, "base_action": base}
+
+
+def _combined(
+    base: np.ndarray, correction: np.ndarray, scale: float, box: spaces.Box
+) -> np.ndarray:
+    """``clip(base + scale * half-range * correction)`` to ``box``."""
+    half = 0.5 * (box.high - box.low)
+    return np.clip(base + scale * half * correction, box.low, box.high).astype(box.dtype)
+
+
+class ResidualPredictor:
+    """A trained residual ``learned`` acting with its scripted ``policy`` (SB3's predictor API)."""
+
+    def __init__(self, learned: Any, policy: ScriptedPolicy, scale: float, box: spaces.Box) -> None:
+        self.learned, self.policy, self.scale, self.box = learned, policy, scale, box
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        correction, state = self.learned.predict(observation, state, episode_start, deterministic)
+        base, _ = self.policy.predict(observation, None, episode_start, True)
+        return _combined(base, correction, self.scale, self.box), state

@@ -64,7 +64,9 @@ from motiongym.agents.model_files import (
 from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
 from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE
 from motiongym.agents.pretrained import write_manifest
+from motiongym.agents.residual import ResidualWrapper
 from motiongym.agents.vector import VectorEnvAdapter
+from motiongym.baselines import scripted_policies
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
@@ -103,6 +105,7 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         venv.seed(seed)
         return _monitored(venv, monitor_dir, "native")
     vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
+    residual = config["residual"]
     return make_vec_env(
         importable_id(env_id),
         n_envs=n_envs,
@@ -110,7 +113,25 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         env_kwargs=config["env_kwargs"],
         monitor_dir=str(monitor_dir) if monitor_dir else None,
         vec_env_cls=vec_env_cls,
+        wrapper_class=ResidualWrapper if residual else None,
+        wrapper_kwargs={"policy": residual, "scale": config["residual_scale"]}
+        if residual
+        else None,
     )
+
+
+def _check_residual(env_id: str, config: dict[str, Any], where: Path) -> None:
+    """A residual agent: a scripted policy of ``env_id``, in a dummy or subproc vec env."""
+    name = config["residual"]
+    if name is None:
+        return
+    if name not in scripted_policies(env_id):
+        choices = ", ".join(sorted(scripted_policies(env_id))) or "none"
+        raise UsageError(
+            f"{where}: residual {name!r} is not a scripted policy of {env_id} ({choices})"
+        )
+    if config["vec_env"] not in ("dummy", "subproc"):
+        raise UsageError(f"{where}: a residual agent needs vec_env dummy or subproc")
 
 
 def _check_her(env_id: str, config: dict[str, Any], where: Path) -> None:
@@ -172,6 +193,7 @@ def train(
     if n_timesteps is not None:
         config["n_timesteps"] = n_timesteps
     _check_her(env_id, config, config_path)
+    _check_residual(env_id, config, config_path)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
     run_dir.mkdir(parents=True, exist_ok=True)

@@ -68,9 +68,11 @@ def test_her_needs_learning_to_start_after_the_first_episode(tmp_path):
             "goal_selection_strategy must be one of",
         ),
         ({"replay_buffer_kwargs": {"copy_info_dict": "yes"}}, "copy_info_dict must be true"),
+        ({"residual": 5}, "residual must be a scripted policy's name"),
+        ({"residual_scale": 3.0}, "residual_scale"),
     ],
 )
-def test_bad_her_settings_are_named(change, message):
+def test_bad_her_and_residual_settings_are_named(change, message):
     path = default_config_path("motiongym/HarvestArmGoal-v1")
     block = {**load_config(path, "sac"), **change}
     from motiongym.agents.config import validate_block

@@ -97,3 +97,29 @@ def test_behaviour_cloning_fits_the_teacher(demonstrations, algorithm):
     assert after < 0.1 * before
     with pytest.raises(ValueError, match="same length"):
         behaviour_clone(model, observations, actions[:-1])
+
+
+def test_a_residual_run_trains_and_evaluates_with_its_scripted_policy(tmp_path):
+    """``residual: newton-raphson-reach`` in a block: the run trains through the wrapper and
+    its model acts through ResidualPredictor (the scripted action plus the correction)."""
+    from motiongym.agents.environments import make_env
+    from motiongym.agents.errors import UsageError
+    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.predictors import load_predictor
+    from motiongym.agents.residual import ResidualPredictor
+    from motiongym.agents.train import train
+
+    config = tmp_path / "residual.yml"
+    config.write_text(
+        "sac:\n  n_timesteps: 64\n  policy: MlpPolicy\n  learning_starts: 16\n  batch_size: 16\n"
+        "  eval_freq: 64\n  n_eval_episodes: 1\n  residual: newton-raphson-reach\n"
+        "  residual_scale: 0.3\n  env_kwargs:\n    max_episode_steps: 30\n"
+    )
+    run_dir = train(REACH, "sac", config, out_root=tmp_path, progress=False)
+    env = make_env(REACH, {"max_episode_steps": 30})
+    predictor = load_predictor(str(run_dir), REACH, env)
+    assert isinstance(predictor, ResidualPredictor) and predictor.scale == 0.3
+    assert 0 < evaluate(env, predictor, [2], REACH, "res", progress=False).episodes[0]["length"]
+    config.write_text(config.read_text().replace("newton-raphson-reach", "potential-field"))
+    with pytest.raises(UsageError, match="not a scripted policy of motiongym/ExcavatorReach-v1"):
+        train(REACH, "sac", config, out_root=tmp_path, progress=False)
