@@ -42,6 +42,10 @@ residual       a scripted policy's name: train a residual agent          null
                ``vec_env`` dummy or subproc
 residual_scale the correction's range, in (0, 2], as a multiple of   1.0
                the action bounds
+demonstrations a Minari dataset folder (``motiongym dataset``): the   null
+               policy is behaviour-cloned on it
+               (:mod:`motiongym.agents.imitation`) before RL
+bc_epochs      epochs of that behaviour cloning                      20
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its
@@ -80,6 +84,8 @@ RUN_SETTINGS: dict[str, Any] = {
     "deterministic": True,
     "residual": None,
     "residual_scale": 1.0,
+    "demonstrations": None,
+    "bc_epochs": 20,
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
@@ -241,6 +247,11 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
             f"residual must be a scripted policy's name, got {config['residual']!r}"
         )
     check_float("residual_scale", config["residual_scale"], 0.0, 2.0, low_open=True)
+    if config["demonstrations"] is not None and not isinstance(config["demonstrations"], str):
+        raise ArgumentError(
+            f"demonstrations must be a dataset folder, got {config['demonstrations']!r}"
+        )
+    check_int("bc_epochs", config["bc_epochs"], 1, 100_000)
     if "log_std_init" in config["policy_kwargs"]:
         check_float("log_std_init", config["policy_kwargs"]["log_std_init"], -20.0, 20.0)
 

@@ -10,7 +10,10 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 * ``command.txt``: the command that made the run;
 * ``eval/``: ``evaluations.npz`` and ``best_model.zip`` (SB3's EvalCallback),
   ``learning_curve.png`` (mean evaluation return against steps);
-* ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs).
+* ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs);
+* ``behaviour_cloning.json``: with ``demonstrations`` in the block, the
+  mean loss of each cloning epoch (the policy is cloned before RL; with
+  normalisation, its statistics start from the demonstrations').
 
 Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
 callback's environment ``seed + 10_000``. Evaluations use seeds from
@@ -25,6 +28,7 @@ environment step; the evaluation callback runs one copy.
 
 from __future__ import annotations
 
+import json
 import shlex
 import shutil
 import sys
@@ -118,6 +122,27 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         if residual
         else None,
     )
+
+
+def _clone(env_id: str, config: dict[str, Any], model, venv, seed: int, run_dir: Path) -> None:
+    """Behaviour-clone ``model`` on the block's ``demonstrations`` (checked for ``env_id``)."""
+    from motiongym.agents.dataset import load_demonstrations, transitions
+    from motiongym.agents.imitation import behaviour_clone
+
+    env = gym.make(env_id, **config["env_kwargs"])
+    try:
+        observations, actions = transitions(load_demonstrations(config["demonstrations"], env))
+    except ValueError as error:
+        raise UsageError(f"demonstrations: {error}") from error
+    if isinstance(venv, VecNormalize):  # statistics from the teacher's states, then applied
+        if isinstance(observations, dict):
+            for key, rms in venv.obs_rms.items():
+                rms.update(observations[key])
+        else:
+            venv.obs_rms.update(observations)
+        observations = venv.normalize_obs(observations)
+    losses = behaviour_clone(model, observations, actions, epochs=config["bc_epochs"], seed=seed)
+    (run_dir / "behaviour_cloning.json").write_text(json.dumps({"loss": losses}) + "\n")
 
 
 def _check_residual(env_id: str, config: dict[str, Any], where: Path) -> None:
@@ -224,6 +249,8 @@ def train(
             )
         except AssertionError as error:  # SB3 checks the spaces with assertions
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
+        if config["demonstrations"]:
+            _clone(env_id, config, model, venv, seed, run_dir)
         eval_dir = run_dir / "eval"
         if algo == "maskableppo":
             from sb3_contrib.common.maskable.callbacks import (

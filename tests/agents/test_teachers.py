@@ -79,7 +79,7 @@ def demonstrations(tmp_path_factory):
     env_id = "motiongym/HarvestArmPlanarGoal-v1"
     path, _ = record_dataset(env_id, "potential-field", 2, tmp_path_factory.mktemp("ds"))
     env = gym.make(env_id)
-    return env, transitions(load_demonstrations(path, env))
+    return env, transitions(load_demonstrations(path, env)), path
 
 
 @pytest.mark.parametrize("algorithm", [SAC, PPO])
@@ -88,7 +88,7 @@ def test_behaviour_cloning_fits_the_teacher(demonstrations, algorithm):
     from motiongym.agents.imitation import behaviour_clone
 
     torch.manual_seed(0)
-    env, (observations, actions) = demonstrations
+    env, (observations, actions), _ = demonstrations
     model = algorithm("MultiInputPolicy", env, policy_kwargs={"net_arch": [64, 64]}, seed=0)
     before = np.mean((model.predict(observations, deterministic=True)[0] - actions) ** 2)
     history = behaviour_clone(model, observations, actions, epochs=40, batch_size=64)
@@ -123,3 +123,27 @@ def test_a_residual_run_trains_and_evaluates_with_its_scripted_policy(tmp_path):
     config.write_text(config.read_text().replace("newton-raphson-reach", "potential-field"))
     with pytest.raises(UsageError, match="not a scripted policy of motiongym/ExcavatorReach-v1"):
         train(REACH, "sac", config, out_root=tmp_path, progress=False)
+
+
+def test_a_run_with_demonstrations_clones_before_rl(demonstrations, tmp_path):
+    """``demonstrations`` in a block: the policy is cloned (the losses fall) before training;
+    a dataset of another ID is refused by name."""
+    import json
+
+    from motiongym.agents.errors import UsageError
+    from motiongym.agents.train import train
+
+    _, _, path = demonstrations
+    config = tmp_path / "bc.yml"
+    config.write_text(
+        "sac:\n  n_timesteps: 64\n  policy: MultiInputPolicy\n  learning_starts: 41\n"
+        "  batch_size: 16\n  replay_buffer_class: her\n  eval_freq: 64\n  n_eval_episodes: 1\n"
+        f"  normalize: {{norm_reward: false}}\n  demonstrations: {path}\n  bc_epochs: 8\n"
+        "  env_kwargs:\n    max_episode_steps: 40\n    collision: 0.0\n"
+    )
+    env_id = "motiongym/HarvestArmPlanarGoal-v1"
+    run_dir = train(env_id, "sac", config, out_root=tmp_path, progress=False)
+    losses = json.loads((run_dir / "behaviour_cloning.json").read_text())["loss"]
+    assert len(losses) == 8 and losses[-1] < 0.5 * losses[0]
+    with pytest.raises(UsageError, match="recorded on 'motiongym/HarvestArmPlanarGoal-v1'"):
+        train("motiongym/HarvestArmGoal-v1", "sac", config, out_root=tmp_path, progress=False)
