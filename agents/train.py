@@ -157,6 +157,11 @@ def _check_residual(env_id: str, config: dict[str, Any], where: Path) -> None:
         )
     if config["vec_env"] not in ("dummy", "subproc"):
         raise UsageError(f"{where}: a residual agent needs vec_env dummy or subproc")
+    if config.get("replay_buffer_class") == "her":  # the stored correction fits one goal only
+        raise UsageError(
+            f"{where}: a residual agent cannot use replay_buffer_class her: the scripted "
+            "action depends on the goal, so a relabelled transition's correction is wrong"
+        )
 
 
 def _check_her(env_id: str, config: dict[str, Any], where: Path) -> None:

@@ -147,3 +147,30 @@ def test_a_run_with_demonstrations_clones_before_rl(demonstrations, tmp_path):
     assert len(losses) == 8 and losses[-1] < 0.5 * losses[0]
     with pytest.raises(UsageError, match="recorded on 'motiongym/HarvestArmPlanarGoal-v1'"):
         train("motiongym/HarvestArmGoal-v1", "sac", config, out_root=tmp_path, progress=False)
+
+
+@pytest.mark.parametrize(
+    "name", ["HarvestArm-v1-residual", "HarvestArmPlanar-v1-residual", "ExcavatorReach-v1-residual"]
+)
+def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
+    """Each shipped residual block, shortened, trains through its scripted policy;
+    with HER it is refused (a relabelled goal changes the scripted action)."""
+    from importlib import resources
+
+    import yaml
+
+    from motiongym.agents.errors import UsageError
+    from motiongym.agents.train import train
+
+    env_id = "motiongym/" + name.removesuffix("-residual")
+    path = resources.files("motiongym.configs") / f"{name}.yml"
+    block = yaml.safe_load(path.read_text())["sac"]
+    block.update(n_timesteps=48, learning_starts=16, batch_size=16, eval_freq=48)
+    block.update(n_eval_episodes=1, env_kwargs={**block["env_kwargs"], "max_episode_steps": 24})
+    config = tmp_path / "tiny.yml"
+    config.write_text(yaml.safe_dump({"sac": block}))
+    assert (train(env_id, "sac", config, out_root=tmp_path, progress=False) / "model.zip").is_file()
+    block.update(replay_buffer_class="her", learning_starts=30)
+    config.write_text(yaml.safe_dump({"sac": block}))
+    with pytest.raises(UsageError, match="cannot use replay_buffer_class her"):
+        train(env_id, "sac", config, out_root=tmp_path, progress=False)
