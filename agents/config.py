@@ -44,7 +44,8 @@ residual_scale the correction's range, in (0, 2], as a multiple of   1.0
                the action bounds
 demonstrations a Minari dataset folder (``motiongym dataset``): the   null
                policy is behaviour-cloned on it
-               (:mod:`motiongym.agents.imitation`) before RL
+               (:mod:`motiongym.agents.imitation`) before RL;
+               normalisation statistics: the demonstrations', frozen
 bc_epochs      epochs of that behaviour cloning                      20
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its

@@ -13,7 +13,7 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 * ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs);
 * ``behaviour_cloning.json``: with ``demonstrations`` in the block, the
   mean loss of each cloning epoch (the policy is cloned before RL; with
-  normalisation, its statistics start from the demonstrations').
+  normalisation, its statistics are the demonstrations', frozen for the run).
 
 Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
 callback's environment ``seed + 10_000``. Evaluations use seeds from
@@ -134,13 +134,16 @@ def _clone(env_id: str, config: dict[str, Any], model, venv, seed: int, run_dir:
         observations, actions = transitions(load_demonstrations(config["demonstrations"], env))
     except ValueError as error:
         raise UsageError(f"demonstrations: {error}") from error
-    if isinstance(venv, VecNormalize):  # statistics from the teacher's states, then applied
+    if isinstance(venv, VecNormalize):  # statistics from the teacher's states, then frozen
         if isinstance(observations, dict):
             for key, rms in venv.obs_rms.items():
                 rms.update(observations[key])
         else:
             venv.obs_rms.update(observations)
         observations = venv.normalize_obs(observations)
+        # Updated by RL's own (first random) states they move the cloned policy's inputs: its
+        # error on the demonstrations doubled in 200 warm-up steps (docs/experiments).
+        venv.training = False
     losses = behaviour_clone(model, observations, actions, epochs=config["bc_epochs"], seed=seed)
     (run_dir / "behaviour_cloning.json").write_text(json.dumps({"loss": losses}) + "\n")
 
