@@ -179,7 +179,9 @@ class GoalConditionedEnv(gym.Env):
     Keyword arguments: ``base`` (the base ID), ``fields`` (``"module:function"``
     returning its :class:`GoalFields`), ``collision`` (>= 0, default 50, the
     penalty of a collision step), ``cost`` (>= 0, default 0, per unit of
-    ``info["cost"]``); every other keyword goes to the base env.
+    ``info["cost"]``); every other keyword goes to the base env (its reward
+    weights change nothing here: the reward is this one; the harvest arm's
+    own ``collision`` weight is shadowed by the penalty of the same name).
 
     Observation: ``Dict(observation, achieved_goal, desired_goal)``, float32,
     bounds the base observation's. ``info``: the base env's, its
