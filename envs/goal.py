@@ -40,6 +40,7 @@ registers its goal IDs with :func:`goal_registration`.
 
 from __future__ import annotations
 
+import functools
 import importlib
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -85,7 +86,7 @@ class GoalFields:
         """The goal's length."""
         return self.desired.stop - self.desired.start
 
-    @property
+    @functools.cached_property
     def kept(self) -> np.ndarray:
         """Indices of the base observation that do not depend on the goal."""
         return np.delete(np.arange(self.base_size), np.r_[self.desired, self.error])
