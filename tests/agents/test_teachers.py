@@ -150,7 +150,13 @@ def test_a_run_with_demonstrations_clones_before_rl(demonstrations, tmp_path):
 
 
 @pytest.mark.parametrize(
-    "name", ["HarvestArm-v1-residual", "HarvestArmPlanar-v1-residual", "ExcavatorReach-v1-residual"]
+    "name",
+    [
+        "HarvestArm-v1-residual",
+        "HarvestArmPlanar-v1-residual",
+        "ExcavatorReach-v1-residual",
+        "Excavator-v1-residual",
+    ],
 )
 def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
     """Each shipped residual block, shortened, trains through its scripted policy;
