@@ -1,4 +1,4 @@
-"""The ``motiongym`` command: list, evaluate, compare, train, ship, record, benchmarks,
+"""The ``motiongym`` command: list, evaluate, compare, train, dataset, ship, record, benchmarks,
 reproduce, bench.
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
@@ -161,6 +161,24 @@ def cmd_train(args: argparse.Namespace) -> None:
     console.print(f"run folder: {run_dir}")
 
 
+def cmd_dataset(args: argparse.Namespace) -> None:
+    from motiongym.agents.dataset import record_dataset
+    from motiongym.agents.report import console
+
+    check_env_id(args.env_id)
+    if args.seed + args.episodes - 1 > MAX_SEED:
+        raise UsageError(f"--seed {args.seed} + --episodes {args.episodes} passes {MAX_SEED}")
+    path, rate = record_dataset(
+        args.env_id,
+        args.policy,
+        args.episodes,
+        args.out,
+        seed=args.seed,
+        env_kwargs=_env_kwargs(args.env_kwargs),
+    )
+    console.print(f"wrote {path} ({args.episodes} episodes, success {rate:.0%})")
+
+
 def cmd_ship(args: argparse.Namespace) -> None:
     from motiongym.agents.report import console
     from motiongym.agents.ship import describe, ship
@@ -321,6 +339,29 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-progress", action="store_true", help="no progress bar (default: a progress bar)"
     )
     train.set_defaults(handler=cmd_train)
+
+    from motiongym.agents.dataset import DATASET_SEED
+
+    dataset = commands.add_parser(
+        "dataset", help="record a scripted policy's episodes as a Minari dataset (offline RL)"
+    )
+    dataset.add_argument("env_id", help="environment ID")
+    dataset.add_argument("--policy", required=True, help="a scripted policy's name")
+    dataset.add_argument("--episodes", type=_count, required=True, help="episodes to record")
+    dataset.add_argument(
+        "--seed",
+        type=_seed,
+        default=DATASET_SEED,
+        help=f"seed of the first episode; episode i uses seed+i (default {DATASET_SEED}, "
+        "clear of the evaluation seeds)",
+    )
+    dataset.add_argument(
+        "--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE", help="keywords for gym.make"
+    )
+    dataset.add_argument(
+        "--out", type=_folder, default=Path("datasets"), help="datasets root (default datasets)"
+    )
+    dataset.set_defaults(handler=cmd_dataset)
 
     ship = commands.add_parser(
         "ship", help="evaluate the seeds' runs of one ID and algorithm, ship the best"

@@ -30,6 +30,23 @@ vec_env        ``dummy``, ``subproc``, ``native`` (the ID's own       dummy
 eval_freq      steps between evaluations (over all envs)             10000
 n_eval_episodes episodes per evaluation                              5
 checkpoint_freq steps between checkpoints (over all envs)            50000
+replay_buffer_class ``her`` (SB3's ``HerReplayBuffer``, for the goal IDs none
+               of :mod:`motiongym.envs.goal`; off-policy only), its
+               keywords in ``replay_buffer_kwargs``
+               (``n_sampled_goal``, ``goal_selection_strategy``
+               ``future``/``final``/``episode``, ``copy_info_dict``:
+               true where the reward reads ``info``)
+residual       a scripted policy's name: train a residual agent          null
+               (:mod:`motiongym.agents.residual`: the env receives
+               that policy's action plus the learned correction);
+               ``vec_env`` dummy or subproc
+residual_scale the correction's range, in (0, 2], as a multiple of   1.0
+               the action bounds
+demonstrations a Minari dataset folder (``motiongym dataset``): the   null
+               policy is behaviour-cloned on it
+               (:mod:`motiongym.agents.imitation`) before RL;
+               normalisation statistics: the demonstrations', frozen
+bc_epochs      epochs of that behaviour cloning                      20
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its
@@ -66,9 +83,17 @@ RUN_SETTINGS: dict[str, Any] = {
     "n_eval_episodes": 5,
     "checkpoint_freq": 50_000,
     "deterministic": True,
+    "residual": None,
+    "residual_scale": 1.0,
+    "demonstrations": None,
+    "bc_epochs": 20,
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
+# Replay buffers a block may name -> their SB3 class names; their keywords.
+REPLAY_BUFFERS = {"her": "HerReplayBuffer"}
+HER_KWARGS = ("n_sampled_goal", "goal_selection_strategy", "copy_info_dict")
+GOAL_SELECTION = ("future", "final", "episode")
 # Activation names accepted in policy_kwargs -> their torch.nn class names.
 ACTIVATIONS = {"tanh": "Tanh", "relu": "ReLU", "elu": "ELU", "leaky_relu": "LeakyReLU"}
 # Constructor arguments the run itself provides.
@@ -217,10 +242,52 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
             raise ArgumentError(f"net_arch must be a list of layer sizes, got {arch!r}")
         for size in layer:
             check_int("net_arch layer size", size, 1, 65_536)
+    _check_replay_buffer(config)
+    if config["residual"] is not None and not isinstance(config["residual"], str):
+        raise ArgumentError(
+            f"residual must be a scripted policy's name, got {config['residual']!r}"
+        )
+    check_float("residual_scale", config["residual_scale"], 0.0, 2.0, low_open=True)
+    if config["demonstrations"] is not None and not isinstance(config["demonstrations"], str):
+        raise ArgumentError(
+            f"demonstrations must be a dataset folder, got {config['demonstrations']!r}"
+        )
+    check_int("bc_epochs", config["bc_epochs"], 1, 100_000)
     if "log_std_init" in config["policy_kwargs"]:
         check_float("log_std_init", config["policy_kwargs"]["log_std_init"], -20.0, 20.0)
 
 
+def _check_replay_buffer(config: dict[str, Any]) -> None:
+    """``replay_buffer_class`` a name of :data:`REPLAY_BUFFERS`, its keywords known."""
+    name = config.get("replay_buffer_class")
+    kwargs = config.get("replay_buffer_kwargs") or {}
+    if name is None:
+        if kwargs:
+            raise ArgumentError("replay_buffer_kwargs needs replay_buffer_class")
+        return
+    check_choice("replay_buffer_class", name, sorted(REPLAY_BUFFERS))
+    if not isinstance(kwargs, dict) or set(kwargs) - set(HER_KWARGS):
+        raise ArgumentError(
+            f"replay_buffer_kwargs must be a mapping with keys among {', '.join(HER_KWARGS)}, "
+            f"got {kwargs!r}"
+        )
+    if "n_sampled_goal" in kwargs:
+        check_int("n_sampled_goal", kwargs["n_sampled_goal"], 1, 1000)
+    if "goal_selection_strategy" in kwargs:
+        check_choice("goal_selection_strategy", kwargs["goal_selection_strategy"], GOAL_SELECTION)
+    if not isinstance(kwargs.get("copy_info_dict", False), bool):
+        raise ArgumentError(
+            f"copy_info_dict must be true or false, got {kwargs['copy_info_dict']!r}"
+        )
+
+
 def algorithm_kwargs(config: dict[str, Any]) -> dict[str, Any]:
-    """The block's keys that go to the algorithm's constructor."""
-    return {key: value for key, value in config.items() if key not in RUN_SETTINGS}
+    """The block's keys that go to the algorithm's constructor (replay buffer named: its class)."""
+    kwargs = {key: value for key, value in config.items() if key not in RUN_SETTINGS}
+    if kwargs.get("replay_buffer_class") is not None:
+        import stable_baselines3
+
+        name = REPLAY_BUFFERS[kwargs["replay_buffer_class"]]
+        kwargs["replay_buffer_class"] = getattr(stable_baselines3, name)
+        kwargs["replay_buffer_kwargs"] = dict(kwargs.get("replay_buffer_kwargs") or {})
+    return kwargs

@@ -97,10 +97,18 @@ def saved_policy(path: Path, data: dict[str, Any]) -> tuple[type[BaseAlgorithm],
     if not isinstance(entry, dict):
         raise UsageError(f"{path}: no policy class recorded")
     module, doc = entry.get("__module__"), entry.get("__doc__")
-    for algorithm in algorithm_classes().values():
-        for policy in algorithm.policy_aliases.values():
-            if policy.__module__ == module and str(policy.__doc__) == doc:
-                return algorithm, policy
+    found = [
+        (algorithm, policy)
+        for algorithm in algorithm_classes().values()
+        for policy in algorithm.policy_aliases.values()
+        if policy.__module__ == module and str(policy.__doc__) == doc
+    ]
+    # SAC's CnnPolicy and MultiInputPolicy share module and docstring; their
+    # recorded __init__ text ("<function MultiInputPolicy.__init__ ...>") tells them apart.
+    init = str(entry.get("__init__", ""))
+    named = [f for f in found if f"<function {f[1].__name__}.__init__" in init]
+    if named or found:
+        return (named or found)[0]
     raise UsageError(f"{path}: no known algorithm saves policies of module {module!r}")
 
 
@@ -208,6 +216,8 @@ def load_archive(
     if "policy_kwargs" in serialized:
         supply["policy_kwargs"] = _policy_kwargs(path, data["policy_kwargs"], policy_kwargs or {})
     custom = {key: supply[key] for key in serialized if key in supply}
+    if data.get("replay_buffer_kwargs"):  # HER's keywords: no replay buffer is needed to act
+        custom["replay_buffer_kwargs"] = {}
     unknown = sorted(set(serialized) - set(supply))
     if unknown:
         raise UsageError(

@@ -17,7 +17,9 @@ episode_start, deterministic)``: a scripted policy from
   agent; it acts in the single-agent environment through
   :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`. A run whose
   ``config.yml`` says ``deterministic: false`` samples its actions
-  (:class:`SampledModel`) whatever its caller asks.
+  (:class:`SampledModel`) whatever its caller asks; one that says
+  ``residual: <policy>`` adds its output to that scripted policy's
+  (:class:`~motiongym.agents.residual.ResidualPredictor`).
 
 The algorithm of a bare ``.zip`` is read from the policy class saved in it
 (PPO and A2C share theirs, and either predicts the same way).
@@ -216,6 +218,16 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
             predictor = MaskedModel(predictor, env)
     if not config.get("deterministic", True):
         predictor = SampledModel(predictor)
+    if config.get("residual"):  # the model learned a correction of a scripted policy
+        from motiongym.agents.residual import ResidualPredictor
+
+        kwargs = env.spec.kwargs if env.spec else resolved_env_kwargs(env_id, None)
+        scripted = make_policy(
+            env_id, config["residual"], env.observation_space, env.action_space, kwargs
+        )
+        predictor = ResidualPredictor(
+            predictor, scripted, config.get("residual_scale", 1.0), env.action_space
+        )
     return predictor
 
 

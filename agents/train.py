@@ -10,7 +10,10 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 * ``command.txt``: the command that made the run;
 * ``eval/``: ``evaluations.npz`` and ``best_model.zip`` (SB3's EvalCallback),
   ``learning_curve.png`` (mean evaluation return against steps);
-* ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs).
+* ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs);
+* ``behaviour_cloning.json``: with ``demonstrations`` in the block, the
+  mean loss of each cloning epoch (the policy is cloned before RL; with
+  normalisation, its statistics are the demonstrations', frozen for the run).
 
 Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
 callback's environment ``seed + 10_000``. Evaluations use seeds from
@@ -25,6 +28,7 @@ environment step; the evaluation callback runs one copy.
 
 from __future__ import annotations
 
+import json
 import shlex
 import shutil
 import sys
@@ -65,7 +69,9 @@ from motiongym.agents.model_files import (
 from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
 from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE
 from motiongym.agents.pretrained import write_manifest
+from motiongym.agents.residual import ResidualWrapper
 from motiongym.agents.vector import VectorEnvAdapter
+from motiongym.baselines import scripted_policies
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
@@ -104,6 +110,7 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         venv.seed(seed)
         return _monitored(venv, monitor_dir, "native")
     vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
+    residual = config["residual"]
     return make_vec_env(
         importable_id(env_id),
         n_envs=n_envs,
@@ -111,7 +118,67 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         env_kwargs=config["env_kwargs"],
         monitor_dir=str(monitor_dir) if monitor_dir else None,
         vec_env_cls=vec_env_cls,
+        wrapper_class=ResidualWrapper if residual else None,
+        wrapper_kwargs={"policy": residual, "scale": config["residual_scale"]}
+        if residual
+        else None,
     )
+
+
+def _clone(env_id: str, config: dict[str, Any], model, venv, seed: int, run_dir: Path) -> None:
+    """Behaviour-clone ``model`` on the block's ``demonstrations`` (checked for ``env_id``)."""
+    from motiongym.agents.dataset import load_demonstrations, transitions
+    from motiongym.agents.imitation import behaviour_clone
+
+    env = gym.make(env_id, **config["env_kwargs"])
+    try:
+        observations, actions = transitions(load_demonstrations(config["demonstrations"], env))
+    except ValueError as error:
+        raise UsageError(f"demonstrations: {error}") from error
+    if isinstance(venv, VecNormalize):  # statistics from the teacher's states, then frozen
+        if isinstance(observations, dict):
+            for key, rms in venv.obs_rms.items():
+                rms.update(observations[key])
+        else:
+            venv.obs_rms.update(observations)
+        observations = venv.normalize_obs(observations)
+        # Updated by RL's own (first random) states they move the cloned policy's inputs: its
+        # error on the demonstrations doubled in 200 warm-up steps (docs/experiments).
+        venv.training = False
+    losses = behaviour_clone(model, observations, actions, epochs=config["bc_epochs"], seed=seed)
+    (run_dir / "behaviour_cloning.json").write_text(json.dumps({"loss": losses}) + "\n")
+
+
+def _check_residual(env_id: str, config: dict[str, Any], where: Path) -> None:
+    """A residual agent: a scripted policy of ``env_id``, in a dummy or subproc vec env."""
+    name = config["residual"]
+    if name is None:
+        return
+    if name not in scripted_policies(env_id):
+        choices = ", ".join(sorted(scripted_policies(env_id))) or "none"
+        raise UsageError(
+            f"{where}: residual {name!r} is not a scripted policy of {env_id} ({choices})"
+        )
+    if config["vec_env"] not in ("dummy", "subproc"):
+        raise UsageError(f"{where}: a residual agent needs vec_env dummy or subproc")
+    if config.get("replay_buffer_class") == "her":  # the stored correction fits one goal only
+        raise UsageError(
+            f"{where}: a residual agent cannot use replay_buffer_class her: the scripted "
+            "action depends on the goal, so a relabelled transition's correction is wrong"
+        )
+
+
+def _check_her(env_id: str, config: dict[str, Any], where: Path) -> None:
+    """HER samples whole episodes: learning must start after the first one can end."""
+    if config.get("replay_buffer_class") != "her":
+        return
+    limit = config["env_kwargs"].get("max_episode_steps", gym.spec(env_id).max_episode_steps) or 0
+    starts = config.get("learning_starts", 100) // config["n_envs"]
+    if starts <= limit:
+        raise UsageError(
+            f"{where}: with replay_buffer_class her, learning_starts / n_envs must exceed "
+            f"{env_id}'s {limit} steps per episode, got {config.get('learning_starts', 100)}"
+        )
 
 
 def _normalize(venv, config: dict[str, Any], training: bool):
@@ -160,6 +227,8 @@ def train(
     config = load_config(config_path, algo)
     if n_timesteps is not None:
         config["n_timesteps"] = n_timesteps
+    _check_her(env_id, config, config_path)
+    _check_residual(env_id, config, config_path)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
     run_dir.mkdir(parents=True, exist_ok=True)
@@ -190,6 +259,8 @@ def train(
             )
         except AssertionError as error:  # SB3 checks the spaces with assertions
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
+        if config["demonstrations"]:
+            _clone(env_id, config, model, venv, seed, run_dir)
         eval_dir = run_dir / "eval"
         if algo == "maskableppo":
             from sb3_contrib.common.maskable.callbacks import (

@@ -39,6 +39,8 @@ class ScriptedPolicy(ABC):
             robot's width) as the environment; never the environment itself.
     """
 
+    env_id: str | None = None  # the ID it was declared for (set by ``make_policy``)
+
     def __init__(
         self,
         observation_space: spaces.Space,

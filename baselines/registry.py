@@ -42,4 +42,6 @@ def make_policy(
         )
     module_name, class_name = declared[name].split(":")
     cls = getattr(importlib.import_module(module_name), class_name)
-    return cls(observation_space, action_space, env_kwargs)
+    policy = cls(observation_space, action_space, env_kwargs)
+    policy.env_id = env_id
+    return policy

@@ -20,6 +20,9 @@ POLICIES: dict[str, dict[str, str]] = {
     "motiongym/Excavator-v1": {
         "dig-cycle": "motiongym.baselines.excavator.policies:DigCyclePolicy",
     },
+    "motiongym/ExcavatorReachGoal-v1": {
+        "newton-raphson-reach": "motiongym.baselines.excavator.policies:GoalReachPolicy",
+    },
 }
 
 # Planning times of `motiongym bench`: label -> ("module:function", goal in s).

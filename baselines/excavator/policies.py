@@ -20,6 +20,7 @@ from gymnasium import spaces
 
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
+from motiongym.baselines.goal import for_goal_env
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.envs.excavator.kinematics import base_pose, base_rotation
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
@@ -256,3 +257,7 @@ class DigCyclePolicy(_ExcavatorPolicy):
 
 def _flat(r: float) -> float:
     return 0.0
+
+
+# The reach policy on the goal-conditioned ID (ExcavatorReachGoal-v1).
+GoalReachPolicy = for_goal_env(ReachPolicy, __name__)

@@ -21,3 +21,8 @@ POLICIES: dict[str, dict[str, str]] = {
     "motiongym/HarvestArm-v1": dict(_POLICIES),
     "motiongym/HarvestArmPlanar-v1": dict(_POLICIES),
 }
+# The goal-conditioned IDs: the same policies reading the goal Dict (baselines/goal.py).
+for _name in ("HarvestArm", "HarvestArmPlanar"):
+    POLICIES[f"motiongym/{_name}Goal-v1"] = {
+        policy: path.replace(":", ":Goal") for policy, path in _POLICIES.items()
+    }

@@ -34,6 +34,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from motiongym.baselines.goal import for_goal_env
 from motiongym.baselines.harvest_arm.potential_field import plan_path
 from motiongym.baselines.harvest_arm.redundancy import limited_rates
 from motiongym.baselines.harvest_arm.reference_velocity import (
@@ -248,3 +249,9 @@ class ResolvedRatePolicy(_ArmPolicy):
         rates = np.linalg.pinv(jacs[-1], rcond=1e-3) @ x_dot
         scale = min(1.0, float(np.min(self.speeds / np.maximum(np.abs(rates), 1e-12))))
         return self._to_action(rates * scale)
+
+
+# The same policies on the goal-conditioned IDs (HarvestArmGoal-v1, ...).
+GoalPotentialFieldPolicy = for_goal_env(PotentialFieldPolicy, __name__)
+GoalExtendedPotentialFieldPolicy = for_goal_env(ExtendedPotentialFieldPolicy, __name__)
+GoalResolvedRatePolicy = for_goal_env(ResolvedRatePolicy, __name__)

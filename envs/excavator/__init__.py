@@ -2,9 +2,14 @@
 
 Paper: ``../shared/papers/002_884a424d690ac408.txt`` (kinematics eq. 1-5,
 Newton-Raphson IK eq. 9-13); our reading: ``../shared/specs/excavator.md``.
+``motiongym/ExcavatorReachGoal-v1``: ``ExcavatorReach-v1`` as a
+goal-conditioned environment (HER), see :mod:`motiongym.envs.goal` and
+:mod:`.goal`.
 """
 
 from __future__ import annotations
+
+from motiongym.envs.goal import goal_registration
 
 REGISTRATIONS: tuple[dict, ...] = (
     {
@@ -29,6 +34,11 @@ REGISTRATIONS: tuple[dict, ...] = (
         "max_episode_steps": 600,
         "kwargs": {"physics": "v1", "slope": 0.1},
     },
+)
+REGISTRATIONS += (
+    goal_registration(
+        REGISTRATIONS[2], "motiongym/ExcavatorReachGoal-v1", f"{__name__}.goal:goal_fields"
+    ),
 )
 
 # Throughput goals of `motiongym bench`: ID -> (reference ID, least ratio to it).

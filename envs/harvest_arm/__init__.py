@@ -6,9 +6,15 @@ Two IDs cover the paper's six arms: ``motiongym/HarvestArm-v0`` (spatial,
 obstacles). ``-v1`` of each also counts self-collision (two non-adjacent
 links touching) as a collision. See
 :class:`motiongym.envs.harvest_arm.env.HarvestArmEnv`.
+
+``motiongym/HarvestArmGoal-v1`` and ``motiongym/HarvestArmPlanarGoal-v1``:
+the ``-v1`` tasks as goal-conditioned environments (HER), see
+:mod:`motiongym.envs.goal` and :mod:`.goal`.
 """
 
 from __future__ import annotations
+
+from motiongym.envs.goal import goal_registration
 
 REGISTRATIONS: tuple[dict, ...] = (
     {
@@ -35,6 +41,11 @@ REGISTRATIONS: tuple[dict, ...] = (
         "max_episode_steps": 300,
         "kwargs": {"dof": 5, "planar": True, "self_collision": True},
     },
+)
+REGISTRATIONS += tuple(
+    goal_registration(base, base["id"].replace("-v1", "Goal-v1"), f"{__name__}.goal:goal_fields")
+    for base in REGISTRATIONS
+    if base["id"].endswith("-v1")
 )
 
 # Throughput goals of `motiongym bench`: ID -> (reference ID, least ratio to it).

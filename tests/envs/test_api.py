@@ -59,7 +59,10 @@ def test_at_least_one_environment_is_registered():
 def test_gymnasium_and_sb3_checkers(env_id):
     env = gym.make(env_id)
     gym_check_env(env.unwrapped, skip_render_check=True)
-    sb3_check_env(gym.make(env_id), warn=True)
+    made = gym.make(env_id)
+    # SB3's checker calls compute_reward on the env it is given; Gymnasium 1's
+    # wrappers no longer forward attributes, so a GoalEnv is checked unwrapped.
+    sb3_check_env(made.unwrapped if hasattr(made.unwrapped, "compute_reward") else made, warn=True)
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

@@ -1,0 +1,97 @@
+"""Residual policy learning: a learned correction on top of a scripted policy.
+
+Silver, Allen, Tenenbaum and Kaelbling (2018), "Residual Policy Learning":
+the agent acts through ``pi(s) = pi_0(s) + f_theta(s)``, where ``pi_0`` is a
+given controller (here a scripted policy of the papers) and ``f_theta`` is
+learned by any RL algorithm; with ``f_theta`` near zero the agent starts as
+good as ``pi_0`` and learns only what it misses.
+
+:class:`ResidualWrapper` puts ``pi_0`` inside the environment: the learner's
+action is the correction ``f``, the environment receives
+``clip(pi_0(s) + scale * f, low, high)`` (clipped to the action space). The
+observation is unchanged, so SB3 trains the residual with its usual
+algorithms; ``info["base_action"]`` is ``pi_0(s)``. :class:`ResidualPredictor`
+acts the same way outside the wrapper (evaluation of a trained residual
+agent: ``motiongym train`` with ``residual: <policy>`` in the config block).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from motiongym.baselines import make_policy
+from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.envs.actions import checked_box_action
+from motiongym.envs.core import check_float
+
+
+class ResidualWrapper(gym.Wrapper):
+    """The env acted on by ``policy`` plus the learner's correction (module docstring).
+
+    Args:
+        env: a made environment (``gym.make``) with a Box action space.
+        policy: the name of a scripted policy declared for ``env``'s ID, or a
+            :class:`ScriptedPolicy` made for that ID (``make_policy``).
+        scale: the correction's range as a multiple of the action bounds, in
+            (0, 2] (1: a correction can move the action anywhere in the box).
+    """
+
+    def __init__(self, env: gym.Env, policy: str | ScriptedPolicy, scale: float = 1.0) -> None:
+        super().__init__(env)
+        env_id = env.spec.id if env.spec else None
+        if not isinstance(env.action_space, spaces.Box):
+            raise ValueError(f"env must have a Box action space, got {env.action_space}")
+        if isinstance(policy, str):
+            policy = make_policy(
+                env_id, policy, env.observation_space, env.action_space, env.spec.kwargs
+            )
+        elif not isinstance(policy, ScriptedPolicy) or policy.env_id != env_id:
+            given = getattr(policy, "env_id", None)
+            raise ValueError(
+                f"policy must be a scripted policy made for {env_id} (make_policy), "
+                f"got {type(policy).__name__} for {given!r}"
+            )
+        self.policy = policy
+        self.scale = check_float("scale", scale, 0.0, 2.0, low_open=True)
+        box = env.action_space
+        self.action_space = spaces.Box(-1.0, 1.0, box.shape, np.float32)
+        self._obs: Any = None
+
+    def reset(self, **kwargs: Any):
+        obs, info = self.env.reset(**kwargs)
+        self.policy.reset()
+        self._obs = obs
+        return obs, info
+
+    def step(self, action: Any):
+        correction = checked_box_action(action, self.action_space.shape, "a correction")
+        base, _ = self.policy.predict(self._obs, deterministic=True)
+        box = self.env.action_space
+        applied = _combined(base, correction, self.scale, box)
+        obs, reward, terminated, truncated, info = self.env.step(applied.astype(box.dtype))
+        self._obs = obs
+        return obs, reward, terminated, truncated, {**info, "base_action": base}
+
+
+def _combined(
+    base: np.ndarray, correction: np.ndarray, scale: float, box: spaces.Box
+) -> np.ndarray:
+    """``clip(base + scale * half-range * correction)`` to ``box``."""
+    half = 0.5 * (box.high - box.low)
+    return np.clip(base + scale * half * correction, box.low, box.high).astype(box.dtype)
+
+
+class ResidualPredictor:
+    """A trained residual ``learned`` acting with its scripted ``policy`` (SB3's predictor API)."""
+
+    def __init__(self, learned: Any, policy: ScriptedPolicy, scale: float, box: spaces.Box) -> None:
+        self.learned, self.policy, self.scale, self.box = learned, policy, scale, box
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        correction, state = self.learned.predict(observation, state, episode_start, deterministic)
+        base, _ = self.policy.predict(observation, None, episode_start, True)
+        return _combined(base, correction, self.scale, self.box), state

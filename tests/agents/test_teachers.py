@@ -1,0 +1,182 @@
+"""The scripted policies as teachers: residual learning and behaviour cloning, by number."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+from stable_baselines3 import PPO, SAC
+
+from motiongym.agents.residual import ResidualWrapper
+from motiongym.baselines import make_policy
+
+REACH = "motiongym/ExcavatorReach-v1"
+
+
+def _scripted_episode(env_id: str, policy: str, seed: int):
+    env = gym.make(env_id)
+    pol = make_policy(env_id, policy, env.observation_space, env.action_space, env.spec.kwargs)
+    obs, _ = env.reset(seed=seed)
+    actions, done = [], False
+    while not done:
+        action, _ = pol.predict(obs)
+        obs, _, terminated, truncated, info = env.step(action)
+        actions.append(action)
+        done = terminated or truncated
+    return np.array(actions), obs, info
+
+
+def test_residual_with_zero_correction_is_the_scripted_policy():
+    """Silver et al.'s starting point: f = 0 acts exactly as pi_0 (same actions, same end)."""
+    actions, last, info = _scripted_episode(REACH, "newton-raphson-reach", seed=4)
+    env = ResidualWrapper(gym.make(REACH), "newton-raphson-reach")
+    obs, _ = env.reset(seed=4)
+    applied = []
+    for _ in range(len(actions)):
+        obs, _, terminated, truncated, step_info = env.step(np.zeros(4, np.float32))
+        applied.append(step_info["base_action"])
+    np.testing.assert_array_equal(applied, actions)
+    np.testing.assert_array_equal(obs, last)
+    assert terminated and step_info["is_success"] == info["is_success"] is True
+
+
+def test_residual_correction_is_scaled_and_clipped_to_the_action_box():
+    env = ResidualWrapper(gym.make(REACH), "newton-raphson-reach", scale=0.5)
+    obs, _ = env.reset(seed=0)
+    base, _ = env.policy.predict(obs)
+    sent = []
+    inner_step = env.env.step
+    env.env.step = lambda a: sent.append(np.array(a)) or inner_step(a)
+    env.step(np.array([1.0, -1.0, 0.2, 0.0], np.float32))
+    expected = np.clip(base + 0.5 * np.array([1.0, -1.0, 0.2, 0.0]), -1.0, 1.0)
+    np.testing.assert_allclose(sent[0], expected, atol=1e-6)
+
+
+def test_residual_refuses_a_policy_of_another_id_and_bad_arguments():
+    other = gym.make("motiongym/ExcavatorReach-v0")
+    policy = make_policy(
+        "motiongym/ExcavatorReach-v0", "newton-raphson-reach",
+        other.observation_space, other.action_space, other.spec.kwargs,
+    )  # fmt: skip
+    with pytest.raises(
+        ValueError, match=r"made for motiongym/ExcavatorReach-v1.*ExcavatorReach-v0"
+    ):
+        ResidualWrapper(gym.make(REACH), policy)
+    with pytest.raises(ValueError, match="scripted policies: newton-raphson-reach"):
+        ResidualWrapper(gym.make(REACH), "potential-field")
+    with pytest.raises(ValueError, match="scale"):
+        ResidualWrapper(gym.make(REACH), "newton-raphson-reach", scale=0.0)
+    with pytest.raises(ValueError, match="Box action space"):
+        ResidualWrapper(gym.make("motiongym/Sweeper-v0"), "boustrophedon")
+
+
+@pytest.fixture(scope="module")
+def demonstrations(tmp_path_factory):
+    pytest.importorskip("minari")
+    from motiongym.agents.dataset import load_demonstrations, record_dataset, transitions
+
+    env_id = "motiongym/HarvestArmPlanarGoal-v1"
+    path, _ = record_dataset(env_id, "potential-field", 2, tmp_path_factory.mktemp("ds"))
+    env = gym.make(env_id)
+    return env, transitions(load_demonstrations(path, env)), path
+
+
+@pytest.mark.parametrize("algorithm", [SAC, PPO])
+def test_behaviour_cloning_fits_the_teacher(demonstrations, algorithm):
+    """The cloned policy's actions on the teacher's states: at least 10x closer than before."""
+    from motiongym.agents.imitation import behaviour_clone
+
+    torch.manual_seed(0)
+    env, (observations, actions), _ = demonstrations
+    model = algorithm("MultiInputPolicy", env, policy_kwargs={"net_arch": [64, 64]}, seed=0)
+    before = np.mean((model.predict(observations, deterministic=True)[0] - actions) ** 2)
+    history = behaviour_clone(model, observations, actions, epochs=40, batch_size=64)
+    after = np.mean((model.predict(observations, deterministic=True)[0] - actions) ** 2)
+    assert len(history) == 40 and history[-1] < 0.1 * history[0]
+    assert after < 0.1 * before
+    with pytest.raises(ValueError, match="same length"):
+        behaviour_clone(model, observations, actions[:-1])
+
+
+def test_a_residual_run_trains_and_evaluates_with_its_scripted_policy(tmp_path):
+    """``residual: newton-raphson-reach`` in a block: the run trains through the wrapper and
+    its model acts through ResidualPredictor (the scripted action plus the correction)."""
+    from motiongym.agents.environments import make_env
+    from motiongym.agents.errors import UsageError
+    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.predictors import load_predictor
+    from motiongym.agents.residual import ResidualPredictor
+    from motiongym.agents.train import train
+
+    config = tmp_path / "residual.yml"
+    config.write_text(
+        "sac:\n  n_timesteps: 64\n  policy: MlpPolicy\n  learning_starts: 16\n  batch_size: 16\n"
+        "  eval_freq: 64\n  n_eval_episodes: 1\n  residual: newton-raphson-reach\n"
+        "  residual_scale: 0.3\n  env_kwargs:\n    max_episode_steps: 30\n"
+    )
+    run_dir = train(REACH, "sac", config, out_root=tmp_path, progress=False)
+    env = make_env(REACH, {"max_episode_steps": 30})
+    predictor = load_predictor(str(run_dir), REACH, env)
+    assert isinstance(predictor, ResidualPredictor) and predictor.scale == 0.3
+    assert 0 < evaluate(env, predictor, [2], REACH, "res", progress=False).episodes[0]["length"]
+    config.write_text(config.read_text().replace("newton-raphson-reach", "potential-field"))
+    with pytest.raises(UsageError, match="not a scripted policy of motiongym/ExcavatorReach-v1"):
+        train(REACH, "sac", config, out_root=tmp_path, progress=False)
+
+
+def test_a_run_with_demonstrations_clones_before_rl(demonstrations, tmp_path):
+    """``demonstrations`` in a block: the policy is cloned (the losses fall) before training;
+    a dataset of another ID is refused by name."""
+    import json
+
+    from motiongym.agents.errors import UsageError
+    from motiongym.agents.train import train
+
+    _, _, path = demonstrations
+    config = tmp_path / "bc.yml"
+    config.write_text(
+        "sac:\n  n_timesteps: 64\n  policy: MultiInputPolicy\n  learning_starts: 41\n"
+        "  batch_size: 16\n  replay_buffer_class: her\n  eval_freq: 64\n  n_eval_episodes: 1\n"
+        f"  normalize: {{norm_reward: false}}\n  demonstrations: {path}\n  bc_epochs: 8\n"
+        "  env_kwargs:\n    max_episode_steps: 40\n    collision: 0.0\n"
+    )
+    env_id = "motiongym/HarvestArmPlanarGoal-v1"
+    run_dir = train(env_id, "sac", config, out_root=tmp_path, progress=False)
+    losses = json.loads((run_dir / "behaviour_cloning.json").read_text())["loss"]
+    assert len(losses) == 8 and losses[-1] < 0.5 * losses[0]
+    with pytest.raises(UsageError, match="recorded on 'motiongym/HarvestArmPlanarGoal-v1'"):
+        train("motiongym/HarvestArmGoal-v1", "sac", config, out_root=tmp_path, progress=False)
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "HarvestArm-v1-residual",
+        "HarvestArmPlanar-v1-residual",
+        "ExcavatorReach-v1-residual",
+        "Excavator-v1-residual",
+    ],
+)
+def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
+    """Each shipped residual block, shortened, trains through its scripted policy;
+    with HER it is refused (a relabelled goal changes the scripted action)."""
+    from importlib import resources
+
+    import yaml
+
+    from motiongym.agents.errors import UsageError
+    from motiongym.agents.train import train
+
+    env_id = "motiongym/" + name.removesuffix("-residual")
+    path = resources.files("motiongym.configs") / f"{name}.yml"
+    block = yaml.safe_load(path.read_text())["sac"]
+    block.update(n_timesteps=48, learning_starts=16, batch_size=16, eval_freq=48)
+    block.update(n_eval_episodes=1, env_kwargs={**block["env_kwargs"], "max_episode_steps": 24})
+    config = tmp_path / "tiny.yml"
+    config.write_text(yaml.safe_dump({"sac": block}))
+    assert (train(env_id, "sac", config, out_root=tmp_path, progress=False) / "model.zip").is_file()
+    block.update(replay_buffer_class="her", learning_starts=30)
+    config.write_text(yaml.safe_dump({"sac": block}))
+    with pytest.raises(UsageError, match="cannot use replay_buffer_class her"):
+        train(env_id, "sac", config, out_root=tmp_path, progress=False)
