@@ -233,7 +233,7 @@ def cmd_reproduce(args: argparse.Namespace) -> None:
 
 
 def cmd_bench(args: argparse.Namespace) -> None:
-    from motiongym.agents.bench import bench
+    from motiongym.agents.throughput import bench
 
     bench(args.out, quick=args.quick, env_ids=args.ids or None)
 

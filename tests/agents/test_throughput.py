@@ -7,7 +7,7 @@ import json
 import gymnasium as gym
 import pytest
 
-from motiongym.agents.bench import (
+from motiongym.agents.throughput import (
     PLANNERS,
     bench,
     markdown,
