@@ -168,7 +168,7 @@ def cmd_benchmarks(args: argparse.Namespace) -> None:
 def cmd_reproduce(args: argparse.Namespace) -> None:
     from motiongym.agents.reproduce import reproduce
 
-    reproduce(args.experiment, args.out / args.experiment, quick=args.quick)
+    reproduce(args.experiment, args.out / args.experiment, quick=args.quick, seeds=args.seeds)
 
 
 def cmd_bench(args: argparse.Namespace) -> None:
@@ -281,6 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")
     reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))
     reproduce.add_argument("--quick", action="store_true", help="reduced protocol")
+    reproduce.add_argument(
+        "--seeds", type=_count, default=None, help="trials per row where the experiment takes it"
+    )
     reproduce.add_argument("--out", type=_folder, default=Path("results/reproduce"))
     reproduce.set_defaults(handler=cmd_reproduce)
 

@@ -490,3 +490,10 @@ class PsaCwaNearestPolicy(PsaCwaPolicy):
 
     pop_order = "nearest"
     cwa_order = "nearest"
+
+
+class PsaCwaDeadReckoningPolicy(PsaCwaPolicy):
+    """PSA + CWA trusting the dead-reckoned pose under odometry error: the ablation
+    of the localiser (:mod:`.localise`), as the policy was before it."""
+
+    localise = False
