@@ -50,11 +50,7 @@ class RobotMap:
         self.hi = np.array([-1, -1])
 
     def integrate(
-        self,
-        obs: dict,
-        cell: tuple[int, int] | None = None,
-        sure: np.ndarray | None = None,
-        sense: bool = True,
+        self, obs: dict, cell: tuple[int, int] | None = None
     ) -> tuple[int, int, int, bool]:
         """Write one observation into the maps; return ``(row, col, heading, bump)``.
 
@@ -63,9 +59,7 @@ class RobotMap:
         ``swept`` window (the environment's dead-reckoned sweep map, right
         only without odometry error). Only cells sensed now are written
         (``known``; all of the window in v0); the others keep what the map
-        held, unknown until first sensed. ``sure``: ``(w, w)`` bool, the footprint
-        cells to mark swept (all by default). ``sense`` False: the window is not
-        written (the pose is too uncertain to file it).
+        held, unknown until first sensed.
         """
         pose = np.asarray(obs["pose"])
         h = int(round(float(pose[2])))
@@ -79,23 +73,20 @@ class RobotMap:
         window = np.asarray(obs["sensed"]).reshape(S, S) > 0.5
         felt = self.felt[r0 : r0 + S, c0 : c0 + S]
         region = self.occ[r0 : r0 + S, c0 : c0 + S]
-        if not sense:
-            pass
+        known = np.asarray(obs["known"]).reshape(S, S) > 0.5 if "known" in obs else True
+        if self.evidence:
+            votes = self.votes[r0 : r0 + S, c0 : c0 + S]
+            step = np.where(window, 1, -1) * known
+            votes[:] = np.clip(votes + step, -self.evidence, self.evidence)
+            window = votes > 0
+        if "known" in obs:
+            region[known] = window[known]
         else:
-            known = np.asarray(obs["known"]).reshape(S, S) > 0.5 if "known" in obs else True
-            if self.evidence:
-                votes = self.votes[r0 : r0 + S, c0 : c0 + S]
-                step = np.where(window, 1, -1) * known
-                votes[:] = np.clip(votes + step, -self.evidence, self.evidence)
-                window = votes > 0
-            if "known" in obs:
-                region[known] = window[known]
-            else:
-                region[:] = window
-        region[felt & sense] = OBSTACLE  # a bump outweighs the range sensor
+            region[:] = window
+        region[felt] = OBSTACLE  # a bump outweighs the range sensor
         if cell is None:
             self.swept[r0 : r0 + S, c0 : c0 + S] |= np.asarray(obs["swept"]).reshape(S, S) > 0.5
-        self.swept[r + o : r + o + w, c + o : c + o + w] |= True if sure is None else sure
+        self.swept[r + o : r + o + w, c + o : c + o + w] = True
         self.lo = np.minimum(self.lo, (r0, c0))
         self.hi = np.maximum(self.hi, (r0 + S, c0 + S))
         return r, c, h, bump

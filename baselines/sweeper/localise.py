@@ -31,10 +31,8 @@ The rules:
   ``exp(-MISMATCH)``, each map obstacle under its footprint by
   ``exp(-BLOCKED)``. Resampled (systematic) when the effective number of
   particles falls below half.
-- **Estimate.** The cell that holds the most weight.
-- **What counts as swept.** Only cells under the footprint with at least
-  ``SURE`` of the weight: where the particles disagree, a cell is left
-  for a later pass rather than believed swept.
+- **Estimate.** The cell that holds the most weight; the map is filed and
+  the footprint marked swept there.
 """
 
 from __future__ import annotations
@@ -48,8 +46,6 @@ from motiongym.envs.sweeper.maps import MAX_SIDE
 
 MISMATCH = 0.5  # log-weight per window cell that disagrees with the map
 BLOCKED = 4.0  # log-weight per map obstacle under the footprint
-SURE = 0.0  # weight a cell needs under the footprint to count as swept
-JITTER = 1.0  # the particles' heading noise over the spec's (against particle deprivation)
 MAX_SLIP = 1.4  # the environment's longest move (cells)
 
 
@@ -73,8 +69,6 @@ class Localiser:
         self.wt = np.full(n, 1.0 / n)
         self.reckoned: tuple[int, int] | None = None  # the last dead-reckoned cell
         self.cell = (0, 0)
-        self.sure = np.ones((w, w), bool)  # footprint cells counted as swept
-        self.confidence = 1.0  # weight of the estimated cell
 
     def locate(self, robot_map: RobotMap, obs: dict) -> tuple[int, int]:
         """The estimated cell for this observation (call before writing it into the map)."""
@@ -97,7 +91,7 @@ class Localiser:
 
     def _move(self, moved: bool, h: int) -> None:
         n = self.n
-        self.e += self.rng.normal(0.0, self.sh * JITTER, n) if self.sh else 0.0
+        self.e += self.rng.normal(0.0, self.sh, n) if self.sh else 0.0
         if moved:
             d = 1.0 + (self.rng.normal(0.0, self.ss, n) if self.ss else 0.0)
             d = np.clip(d, 0.0, MAX_SLIP)
@@ -153,14 +147,6 @@ class Localiser:
         mass = np.bincount(inv.ravel(), weights=self.wt, minlength=len(uniq))
         best = uniq[int(np.argmax(mass))]
         self.cell = int(best[0]), int(best[1])
-        self.confidence = float(mass.max())
-        # footprint cells (relative to the estimate) and the weight that covers each
-        w = self.w
-        cover = np.zeros((3 * w, 3 * w))
-        for (r, c), m in zip((uniq - best).tolist(), mass.tolist(), strict=True):
-            if abs(r) < w and abs(c) < w:
-                cover[w + r : 2 * w + r, w + c : 2 * w + c] += m
-        self.sure = cover[w : 2 * w, w : 2 * w] >= SURE
 
     @property
     def spread(self) -> float:

@@ -9,6 +9,19 @@ believed ``pose`` and plans on those maps, treating unknown cells as free
 until sensed. Under odometry noise a bump marks the cells ahead as obstacle
 and the current plan is dropped; the felt cells stay obstacles (whatever the
 drifted window says) until the robot has moved on.
+
+Under odometry noise (the robot's spec, ``heading_noise`` / ``slip_noise``
+of its keywords) the believed pose is the localiser's (:mod:`.localise`,
+Monte Carlo localisation on the policy's own map) instead of the dead-
+reckoned ``pose``, the map is kept by occupancy votes
+(:class:`.belief.RobotMap` ``evidence``), and "done" is declared only when
+the map holds no reachable floor unswept or unknown: a bump is not taken as
+proof of a wall at that point (the felt marks are dropped and the map looked
+at again), and a scan that finds the same leftovers as the last one sends
+the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
+:class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
+dead-reckoned pose. ``diagnostics()["done"]`` says when the policy has
+declared itself done.
 """
 
 from __future__ import annotations
@@ -31,7 +44,6 @@ from motiongym.envs.sweeper.params import SweeperParams
 FORWARD, LEFT, RIGHT = 0, 1, 2
 EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
 MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
-CONFIDENT = 0.0  # localiser weight on its cell needed to file the window in the map
 
 
 def turn_towards(heading: int, target: int) -> int:
@@ -87,6 +99,7 @@ class PsaCwaPolicy(ScriptedPolicy):
 
     localise = True  # correct the pose by scan matching when the odometry is noisy
     max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
+    evidence = EVIDENCE  # map votes when localising (0: the latest window wins)
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -100,7 +113,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         if not (self.localise and p.noisy):
             return Memory(RobotMap(self.w, self.R))
         loc = Localiser(self.w, self.R, p.heading_noise, p.slip_noise)
-        return Memory(RobotMap(self.w, self.R, EVIDENCE), loc)
+        return Memory(RobotMap(self.w, self.R, self.evidence), loc)
 
     def describe(self, memory: Memory) -> dict[str, Any]:
         """``mode`` (the algorithm's step), ``done`` (True once it has declared the
@@ -121,8 +134,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         m.steps += 1
         if m.loc is not None:
             cell = m.loc.locate(m.map, observation)
-            sense = m.loc.confidence >= CONFIDENT
-            r, c, h, bump = m.map.integrate(observation, cell, m.loc.sure, sense)
+            r, c, h, bump = m.map.integrate(observation, cell)
         else:
             r, c, h, bump = m.map.integrate(observation)
         if not m.started:

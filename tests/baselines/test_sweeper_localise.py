@@ -99,3 +99,31 @@ def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
             )
     assert np.mean(ours) > np.mean(ablation) + 0.1
     assert np.min(ours) > np.min(ablation)
+
+
+class NoVotes(PsaCwaPolicy):
+    """Ablation: the localised policy's map keeps the latest window, not votes."""
+
+    evidence = 0
+
+
+class NoStalls(PsaCwaPolicy):
+    """Ablation: done at the first scan that finds nothing new (and bump marks kept)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.max_stalls = 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ablation", [NoVotes, NoStalls, PsaCwaDeadReckoningPolicy])
+def test_each_mechanism_earns_its_place(ablation) -> None:
+    """Shipped maps, seeds 0-2; measured mean (min) coverage at done: 94.2 % (69.3 %)
+    with all; 90.4 % (67.9 %) without votes; 87.1 % (30.2 %) without the stall rule."""
+    ours, theirs = [], []
+    for map_name in ("room", "apartment", "maze"):
+        for seed in range(3):
+            ours.append(coverage_at_done(PsaCwaPolicy, seed, map_name=map_name, **NOISE)[0])
+            theirs.append(coverage_at_done(ablation, seed, map_name=map_name, **NOISE)[0])
+    assert np.mean(ours) > np.mean(theirs) + 0.02
+    assert np.min(ours) >= np.min(theirs)
