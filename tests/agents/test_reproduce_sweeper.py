@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
+from motiongym.agents.errors import UsageError
+from motiongym.agents.reproduce import experiments, reproduce
 from motiongym.agents.reproduce.sweeper import run
 
 
@@ -45,3 +49,9 @@ def test_reproduce_sweeper_quick(tmp_path, capsys) -> None:
     assert wk["psa_coverage"] == 1.0 and wk["weak_coverage_same_steps"] < 1.0
     for name in results["figures"]:
         assert (tmp_path / name).stat().st_size > 1000
+
+
+def test_seeds_only_for_an_experiment_that_takes_them(tmp_path) -> None:
+    others = [name for name in experiments() if name != "sweeper"]
+    with pytest.raises(UsageError, match="takes no --seeds"):
+        reproduce(others[0], tmp_path, quick=True, seeds=3)
