@@ -229,7 +229,7 @@ def cmd_benchmarks(args: argparse.Namespace) -> None:
 def cmd_reproduce(args: argparse.Namespace) -> None:
     from motiongym.agents.reproduce import reproduce
 
-    reproduce(args.experiment, args.out / args.experiment, quick=args.quick)
+    reproduce(args.experiment, args.out / args.experiment, quick=args.quick, seeds=args.seeds)
 
 
 def cmd_bench(args: argparse.Namespace) -> None:
@@ -421,6 +421,12 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("experiment", choices=sorted(EXPERIMENTS))
     reproduce.add_argument(
         "--quick", action="store_true", help="reduced protocol (default: the full one)"
+    )
+    reproduce.add_argument(
+        "--seeds",
+        type=_count,
+        default=None,
+        help="trials per row where the experiment takes it (default: the experiment's own)",
     )
     reproduce.add_argument(
         "--out",

@@ -86,7 +86,7 @@ class Step:
     info: dict[str, Any]
 
 
-StepHook = Callable[[Step], None]
+StepHook = Callable[[Step], bool | None]
 
 
 def run_episode(
@@ -104,6 +104,9 @@ def run_episode(
     ``hook``, if given, is called after every step with a :class:`Step`; a
     reproduction collects what it needs there (a policy's public
     ``diagnostics()``, a world's measure) instead of writing its own loop.
+    A hook that returns True ends the episode after that step (a
+    reproduction that has what it came for, such as the step at which a
+    policy declared itself done); the measures then cover the steps run.
     """
     measures = info_measures(env)
     observation, _ = env.reset(seed=seed, options=options)
@@ -118,8 +121,9 @@ def run_episode(
             )
             previous = observation
             observation, reward, terminated, truncated, info = env.step(action)
+            stop = False
             if hook is not None:
-                hook(
+                stop = hook(
                     Step(
                         length,
                         predictor,
@@ -135,7 +139,7 @@ def run_episode(
             episode_start = np.zeros(1, dtype=bool)
             episode_return += float(reward)
             length += 1
-            done = terminated or truncated
+            done = terminated or truncated or bool(stop)
             for key in measures:
                 trace[key].append(float(info[key]))
     result = {"seed": seed, "return": episode_return, "length": length}

@@ -9,6 +9,7 @@ a reduced protocol (fewer trials) for tests.
 from __future__ import annotations
 
 import importlib
+import inspect
 from pathlib import Path
 from typing import Any
 
@@ -24,9 +25,17 @@ def experiments() -> dict[str, str]:
 EXPERIMENTS = experiments()
 
 
-def reproduce(name: str, out_dir: Path, quick: bool = False) -> dict[str, Any]:
-    """Run the experiment ``name`` (one of :func:`experiments`)."""
+def reproduce(
+    name: str, out_dir: Path, quick: bool = False, seeds: int | None = None
+) -> dict[str, Any]:
+    """Run the experiment ``name`` (one of :func:`experiments`); ``seeds``, where an
+    experiment takes it (its ``run`` has a ``seeds`` argument), sets its trial count."""
     found = experiments()
     if name not in found:
         raise UsageError(f"unknown experiment {name!r}; valid: {', '.join(found)}")
-    return importlib.import_module(found[name]).run(out_dir, quick=quick)
+    run = importlib.import_module(found[name]).run
+    if seeds is None:
+        return run(out_dir, quick=quick)
+    if "seeds" not in inspect.signature(run).parameters:
+        raise UsageError(f"experiment {name!r} takes no --seeds")
+    return run(out_dir, quick=quick, seeds=seeds)

@@ -22,8 +22,10 @@ writes into ``out_dir`` (``sweeper.json`` and PNG figures):
    degrees to the walls) from a fixed start on the maze, travel spread beside
    the paper's < 3 %; and, apart, the maze turned on the grid by 0-90
    degrees (walls become staircases), which is not the paper's setting.
-4. Odometry error (4.2, Fig. 20, the paper's open problem): coverage and
-   travel against heading and slip noise.
+4. Odometry error (4.2, Fig. 20, the paper's open problem): on ``Sweeper-v1``,
+   coverage at the moment the policy declares itself done, with and without
+   its localiser, against heading and slip noise on the room, apartment,
+   maze and procedural maps (:mod:`.sweeper_odometry`).
 5. The weak baseline (section 2, Fig. 1) on an empty room beside the paper's
    ~90 % coverage.
 """
@@ -39,6 +41,7 @@ import gymnasium as gym
 import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
+from motiongym.agents.reproduce import sweeper_odometry
 from motiongym.baselines.sweeper.run import make_policy, run_episode
 from motiongym.envs.sweeper import generator, maps, occupancy
 
@@ -248,32 +251,6 @@ def walls_turned_study(quick: bool) -> dict:
     }
 
 
-def odometry_study(quick: bool) -> dict:
-    """Coverage and travel on the room against heading / slip noise."""
-    levels = [(0.0, 0.0), (0.02, 0.0), (0.0, 0.1)] if quick else [
-        (0.0, 0.0), (0.005, 0.0), (0.01, 0.0), (0.02, 0.0), (0.05, 0.0),
-        (0.0, 0.05), (0.0, 0.1), (0.0, 0.2), (0.02, 0.1),
-    ]  # fmt: skip
-    seeds = range(2 if quick else 8)
-    rows = []
-    for heading_noise, slip_noise in levels:
-        env = _env(map_name="room", heading_noise=heading_noise, slip_noise=slip_noise)
-        runs = [_episode(env, "psa-cwa", s, max_steps=3000) for s in seeds]
-        rows.append(
-            {
-                "heading_noise": heading_noise,
-                "slip_noise": slip_noise,
-                "coverage": float(np.mean([r["coverage"] for r in runs])),
-                "coverage_min": float(np.min([r["coverage"] for r in runs])),
-                "travel": float(np.mean([r["travel"] for r in runs])),
-                "bumps": float(np.mean([r["bumps"] for r in runs])),
-                "all_swept": int(sum(r["is_success"] for r in runs)),
-                "episodes": len(runs),
-            }
-        )
-    return {"rows": rows, "max_steps": 3000}
-
-
 def weak_baseline_study(quick: bool) -> dict:
     """Wall-following / least-swept-direction vs PSA + CWA on an empty 30 x 40 room."""
     room = generator.empty_room(30, 40)
@@ -352,13 +329,18 @@ def _figures(out_dir: pathlib.Path, results: dict) -> list[str]:
     fig.savefig(out_dir / files[-1], dpi=100)
     plt.close(fig)
 
-    rows = results["odometry"]["rows"]
-    fig, ax = plt.subplots(figsize=(7, 4))
-    labels = [f"h{r['heading_noise']}/s{r['slip_noise']}" for r in rows]
-    ax.bar(labels, [100 * r["coverage"] for r in rows])
-    ax.set_ylabel("coverage (%)")
-    ax.set_title("odometry error (Fig. 20): heading rad / slip")
-    ax.tick_params(axis="x", rotation=45)
+    rows = [r for r in results["odometry"]["rows"] if r["map"] == "maze"]
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for k, localise in enumerate((True, False)):
+        sel = [r for r in rows if r["localise"] is localise]
+        x = np.arange(len(sel)) + 0.4 * k
+        label = "localised" if localise else "dead reckoning"
+        ax.bar(x, [100 * r["coverage"] for r in sel], width=0.4, label=label)
+    ax.set_xticks(np.arange(len(sel)) + 0.2)
+    ax.set_xticklabels([f"h{r['heading_noise']}/s{r['slip_noise']}" for r in sel], rotation=45)
+    ax.set_ylabel("coverage when it declared done (%)")
+    ax.set_title(f"odometry error on the {sel[0]['map']} (Fig. 20): heading rad / slip")
+    ax.legend()
     fig.tight_layout()
     files.append("sweeper_odometry.png")
     fig.savefig(out_dir / files[-1], dpi=100)
@@ -446,23 +428,33 @@ def _print(results: dict) -> None:
     )
     console.print(t)
 
-    t = Table(title="Odometry error on the room (paper: open problem, Fig. 20)")
-    for col in ("heading noise (rad/action)", "slip (rel.)", "coverage", "min", "travel", "bumps"):
+    t = Table(title="Odometry error on Sweeper-v1 (paper: open problem, Fig. 20)")
+    for col in ("heading (rad/action)", "slip", "map", "localised", "coverage", "min", "early"):
         t.add_column(col)
     for r in results["odometry"]["rows"]:
         t.add_row(
             f"{r['heading_noise']}",
             f"{r['slip_noise']}",
+            r["map"],
+            "yes" if r["localise"] else "no",
             f"{100 * r['coverage']:.1f} %",
             f"{100 * r['coverage_min']:.1f} %",
-            f"{r['travel']:.0f}",
-            f"{r['bumps']:.1f}",
+            f"{r['early_stops']}/{r['episodes']}",
         )
     console.print(t)
+    for name, row in results["odometry"]["summary"].items():
+        console.print(
+            f"{name}: coverage {100 * row['coverage']:.1f} % mean, "
+            f"{100 * row['coverage_min']:.1f} % worst, "
+            f"{row['early_stops']} of {row['episodes']} stopped early"
+        )
 
 
-def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
-    """Run every study, print ours beside the paper's, write JSON and figures."""
+def run(out_dir: pathlib.Path, quick: bool = False, seeds: int | None = None) -> dict:
+    """Run every study, print ours beside the paper's, write JSON and figures.
+
+    ``seeds``: episodes per row of the odometry table
+    (:func:`.sweeper_odometry.odometry_table`; default 1 quick, 2 full)."""
     out_dir = pathlib.Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -470,7 +462,8 @@ def run(out_dir: pathlib.Path, quick: bool = False) -> dict:
     results["coverage"] = coverage_study(quick)
     results["start_position"] = start_position_study(quick)
     results["orientation"] = orientation_study(quick)
-    results["odometry"] = odometry_study(quick)
+    results["odometry"] = sweeper_odometry.odometry_table(quick, seeds)
+    results["odometry"]["summary"] = sweeper_odometry.summary(results["odometry"]["rows"])
     results["weak_baseline"] = weak_baseline_study(quick)
     results["figures"] = _figures(out_dir, results)
     results["wall_s"] = time.perf_counter() - t0

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+_SWEEPER_POLICIES = {
+    "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
+    "psa-cwa-nearest": "motiongym.baselines.sweeper.psa_cwa:PsaCwaNearestPolicy",
+    "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
+}
+# The same policies on v0 (see-through window) and v1 (line of sight: they keep
+# v1's unknown cells unknown until sensed).
 POLICIES: dict[str, dict[str, str]] = {
-    "motiongym/Sweeper-v0": {
-        "psa-cwa": "motiongym.baselines.sweeper.psa_cwa:PsaCwaPolicy",
-        "psa-cwa-nearest": "motiongym.baselines.sweeper.psa_cwa:PsaCwaNearestPolicy",
-        "wall-follow": "motiongym.baselines.sweeper.wall_follow:WallFollowPolicy",
-    },
+    "motiongym/Sweeper-v0": dict(_SWEEPER_POLICIES),
+    "motiongym/Sweeper-v1": dict(_SWEEPER_POLICIES),
 }
 
 # Planning times of `motiongym bench`: label -> ("module:function", goal in s).

@@ -9,6 +9,19 @@ believed ``pose`` and plans on those maps, treating unknown cells as free
 until sensed. Under odometry noise a bump marks the cells ahead as obstacle
 and the current plan is dropped; the felt cells stay obstacles (whatever the
 drifted window says) until the robot has moved on.
+
+Under odometry noise (the robot's spec, ``heading_noise`` / ``slip_noise``
+of its keywords) the believed pose is the localiser's (:mod:`.localise`,
+Monte Carlo localisation on the policy's own map) instead of the dead-
+reckoned ``pose``, the map is kept by occupancy votes
+(:class:`.belief.RobotMap` ``evidence``), and "done" is declared only when
+the map holds no reachable floor unswept or unknown: a bump is not taken as
+proof of a wall at that point (the felt marks are dropped and the map looked
+at again), and a scan that finds the same leftovers as the last one sends
+the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
+:class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
+dead-reckoned pose. ``diagnostics()["done"]`` says when the policy has
+declared itself done.
 """
 
 from __future__ import annotations
@@ -23,11 +36,14 @@ from gymnasium import spaces
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper import cwa, psa, quadtree
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
+from motiongym.baselines.sweeper.localise import Localiser
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.occupancy import DC, DR
 from motiongym.envs.sweeper.params import SweeperParams
 
 FORWARD, LEFT, RIGHT = 0, 1, 2
+EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
+MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
 
 
 def turn_towards(heading: int, target: int) -> int:
@@ -47,6 +63,7 @@ class Memory:
     """One episode's state of the sweeping algorithm."""
 
     map: RobotMap
+    loc: Localiser | None = None  # pose correction under odometry error (None: trust the pose)
     mode: str = "lane"  # lane | shift | pop | transfer | cwa_scan | cwa_pop | cwa_follow | done
     path: deque = field(default_factory=deque)  # configurations still to visit
     goal: tuple[int, int] | None = None
@@ -61,6 +78,9 @@ class Memory:
     cwa_stack: list = field(default_factory=list)
     cwa_cells: np.ndarray | None = None
     cwa_last: tuple[int, int] | None = None  # (swept cells, leftovers) at the last scan
+    steps: int = 0  # observations acted on
+    stalled_at: int = -1  # the step of the last stall
+    stalls: int = 0  # scans in a row that found the same leftovers (each sends it to the nearest)
     started: bool = False
     last_pose: tuple[int, int] | None = None
     log: list = field(default_factory=list)  # (mode, pose) at each decision, for figures
@@ -77,17 +97,46 @@ class PsaCwaPolicy(ScriptedPolicy):
     restart_axis = True  # a popped run may turn its lanes across (psa.restart_heading)
     push_behind = True  # push the segment in line behind a lane that starts after a shift
 
+    localise = True  # correct the pose by scan matching when the odometry is noisy
+    max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
+    evidence = EVIDENCE  # map votes when localising (0: the latest window wins)
+
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
         self.w, self.R = robot_geometry(observation_space, self.env_kwargs)
+        self.params = SweeperParams.from_kwargs(self.env_kwargs)
+        if self.localise and self.params.noisy:
+            self.max_stalls = MAX_STALLS
 
     def new_memory(self) -> Memory:
-        return Memory(RobotMap(self.w, self.R))
+        p = self.params
+        if not (self.localise and p.noisy):
+            return Memory(RobotMap(self.w, self.R))
+        loc = Localiser(self.w, self.R, p.heading_noise, p.slip_noise)
+        return Memory(RobotMap(self.w, self.R, self.evidence), loc)
+
+    def describe(self, memory: Memory) -> dict[str, Any]:
+        """``mode`` (the algorithm's step), ``done`` (True once it has declared the
+        area swept: its map holds no reachable floor unswept or unknown), ``pose``
+        (the cell it believes its footprint at) and ``spread`` (the localiser's
+        position spread in cells, 0.0 without one)."""
+        m = memory
+        return {
+            "mode": m.mode,
+            "done": m.mode == "done",
+            "pose": m.last_pose,
+            "spread": m.loc.spread if m.loc is not None else 0.0,
+        }
 
     # ----------------------------------------------------------------- acting
     def act(self, observation: Any, memory: Memory) -> int:
         m = memory
-        r, c, h, bump = m.map.integrate(observation)
+        m.steps += 1
+        if m.loc is not None:
+            cell = m.loc.locate(m.map, observation)
+            r, c, h, bump = m.map.integrate(observation, cell)
+        else:
+            r, c, h, bump = m.map.integrate(observation)
         if not m.started:
             m.started = True
             m.run_heading, m.run_side = h, psa.right_of(h)
@@ -331,11 +380,22 @@ class PsaCwaPolicy(ScriptedPolicy):
         origin, occ, swept, cfree, cur = self._known(m, r, c)
         reach = occupancy.reachable_configs(cfree, cur)
         targets = cwa.leftovers(occ, swept, reach, self.w)
+        if self.max_stalls and not targets.any() and m.map.felt.any():  # a bump: look again
+            m.map.forget_felt(unmark=True)
+            return None
         state = (int(m.map.swept.sum()), int(targets.sum()))
+        if state == m.cwa_last and targets.any() and m.stalls < self.max_stalls:
+            if m.stalled_at == m.steps:  # stalled twice without acting: step off the spot
+                occ_ahead, _ = m.map.footprint(r + int(DR[h]), c + int(DC[h]))
+                return LEFT if (occ_ahead == OBSTACLE).any() else FORWARD
+            m.stalls, m.stalled_at = m.stalls + 1, m.steps  # head for the nearest leftover
+            m.cwa_cells = np.argwhere(targets) + np.array(origin)
+            m.mode = "cwa_follow"
+            return None
         if not targets.any() or state == m.cwa_last:
             m.mode = "done"
             return None
-        m.cwa_last = state
+        m.cwa_last, m.stalls = state, 0
         wide = (occupancy.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
         if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
             return self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
@@ -442,3 +502,10 @@ class PsaCwaNearestPolicy(PsaCwaPolicy):
 
     pop_order = "nearest"
     cwa_order = "nearest"
+
+
+class PsaCwaDeadReckoningPolicy(PsaCwaPolicy):
+    """PSA + CWA trusting the dead-reckoned pose under odometry error: the ablation
+    of the localiser (:mod:`.localise`), as the policy was before it."""
+
+    localise = False

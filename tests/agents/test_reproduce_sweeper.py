@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
+from motiongym.agents.errors import UsageError
+from motiongym.agents.reproduce import experiments, reproduce
 from motiongym.agents.reproduce.sweeper import run
 
 
@@ -29,9 +33,25 @@ def test_reproduce_sweeper_quick(tmp_path, capsys) -> None:
     assert ori["starts"] == 5 and ori["spread_starts_max"] >= ori["spread_starts_mean"]
     assert all(row["coverage"] == 1.0 for row in ori["walls_turned"]["rows"])
     rows = results["odometry"]["rows"]
-    assert rows[0]["coverage"] == 1.0 and rows[0]["heading_noise"] == 0.0
-    assert min(r["coverage"] for r in rows[1:]) < 1.0  # noise costs coverage
+    assert {(r["map"], r["localise"]) for r in rows} == {
+        (m, loc) for m in ("room", "maze") for loc in (True, False)
+    }
+    assert all(r["heading_noise"] == 0.01 and r["slip_noise"] == 0.05 for r in rows)
+    for name in ("room", "maze"):  # measured: 98.6 / 97.8 % localised, 80.6 / 90.1 % not
+        loc, dead = (
+            next(r for r in rows if r["map"] == name and r["localise"] is k) for k in (True, False)
+        )
+        assert loc["coverage"] > dead["coverage"] + 0.05 and loc["coverage"] > 0.95
+    summary = results["odometry"]["summary"]
+    assert summary["localised"]["episodes"] == summary["dead reckoning"]["episodes"] == 2
+    assert "stopped early" in printed
     wk = results["weak_baseline"]
     assert wk["psa_coverage"] == 1.0 and wk["weak_coverage_same_steps"] < 1.0
     for name in results["figures"]:
         assert (tmp_path / name).stat().st_size > 1000
+
+
+def test_seeds_only_for_an_experiment_that_takes_them(tmp_path) -> None:
+    others = [name for name in experiments() if name != "sweeper"]
+    with pytest.raises(UsageError, match="takes no --seeds"):
+        reproduce(others[0], tmp_path, quick=True, seeds=3)

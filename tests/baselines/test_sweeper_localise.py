@@ -1,0 +1,129 @@
+"""PSA + CWA under odometry error on Sweeper-v1: the localiser, its ablation, and "done"."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import motiongym  # noqa: F401
+from motiongym.agents.evaluate import run_episode
+from motiongym.baselines.sweeper.psa_cwa import PsaCwaDeadReckoningPolicy, PsaCwaPolicy
+
+ENV_ID = "motiongym/Sweeper-v1"
+NOISE = {"heading_noise": 0.01, "slip_noise": 0.05}
+
+
+def l_shape() -> np.ndarray:
+    """An L-shaped hall (a map nobody tuned on)."""
+    g = np.zeros((36, 44), bool)
+    g[0, :] = g[-1, :] = g[:, 0] = g[:, -1] = True
+    g[:21, 22:] = True
+    return g
+
+
+def spiral() -> np.ndarray:
+    """A spiral corridor five to six cells wide."""
+    g = np.zeros((41, 41), bool)
+    g[0, :] = g[-1, :] = g[:, 0] = g[:, -1] = True
+    g[6, 6:35] = g[6:35, 34] = g[34, 6:35] = g[12:35, 6] = True
+    g[12, 6:29] = g[12:29, 28] = g[28, 12:29] = g[18:29, 12] = g[18, 12:23] = True
+    return g
+
+
+def office() -> np.ndarray:
+    """Two rows of offices off a corridor, a door five wide into each, two desks."""
+    g = np.zeros((40, 52), bool)
+    g[0, :] = g[-1, :] = g[:, 0] = g[:, -1] = True
+    g[17, :] = g[23, :] = True
+    for c in (13, 26, 39):
+        g[:17, c] = g[24:, c] = True
+    for c0 in (3, 16, 29, 42):
+        g[17, c0 : c0 + 5] = False
+        g[23, c0 + 2 : c0 + 7] = False
+    g[6:9, 4:9] = g[30:33, 30:35] = True
+    return g
+
+
+def coverage_at_done(cls, seed: int, **kwargs) -> tuple[float, bool]:
+    """Coverage at the step the policy declares itself done (read by the loop's hook)."""
+    env = gym.make(ENV_ID, **kwargs)
+    policy = cls(env.observation_space, env.action_space, {**gym.spec(ENV_ID).kwargs, **kwargs})
+    seen = {"done": False}
+
+    def hook(step) -> bool:
+        seen["coverage"] = step.info["coverage"]
+        seen["done"] = policy.diagnostics()["done"]
+        return seen["done"]
+
+    run_episode(env, policy, seed, hook=hook)
+    return seen["coverage"], seen["done"]
+
+
+def test_no_localiser_without_noise_and_full_coverage_on_v1() -> None:
+    env = gym.make(ENV_ID)
+    policy = PsaCwaPolicy(env.observation_space, env.action_space, gym.spec(ENV_ID).kwargs)
+    assert policy.new_memory().loc is None and policy.max_stalls == 0
+    for map_name in ("room", "apartment", "maze"):
+        coverage, done = coverage_at_done(PsaCwaPolicy, 0, map_name=map_name)
+        assert coverage == 1.0  # the environment ends on full coverage before "done"
+
+
+def test_diagnostics_report_done_and_pose() -> None:
+    env = gym.make(ENV_ID, **NOISE)
+    policy = PsaCwaPolicy(env.observation_space, env.action_space, NOISE)
+    obs, _ = env.reset(seed=0)
+    policy.predict(obs, episode_start=np.ones(1, bool))
+    d = policy.diagnostics()
+    assert set(d) == {"mode", "done", "pose", "spread"} and d["done"] is False
+    assert d["pose"] == tuple(int(v) for v in obs["pose"][:2]) and d["spread"] == 0.0
+
+
+def test_localised_beats_dead_reckoning_on_the_room() -> None:
+    # measured (seed 0): 98.6 % localised, 80.6 % dead reckoning, both declared done
+    loc, loc_done = coverage_at_done(PsaCwaPolicy, 0, map_name="room", **NOISE)
+    dead, dead_done = coverage_at_done(PsaCwaDeadReckoningPolicy, 0, map_name="room", **NOISE)
+    assert loc_done and dead_done
+    assert loc > 0.97 and dead < 0.85
+
+
+@pytest.mark.slow
+def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
+    """L, office, spiral (written here, never tuned on), seeds 0-2."""
+    ours, ablation = [], []
+    for make in (l_shape, office, spiral):
+        for seed in range(3):
+            ours.append(coverage_at_done(PsaCwaPolicy, seed, grid=make(), **NOISE)[0])
+            ablation.append(
+                coverage_at_done(PsaCwaDeadReckoningPolicy, seed, grid=make(), **NOISE)[0]
+            )
+    assert np.mean(ours) > np.mean(ablation) + 0.1
+    assert np.min(ours) > np.min(ablation)
+
+
+class NoVotes(PsaCwaPolicy):
+    """Ablation: the localised policy's map keeps the latest window, not votes."""
+
+    evidence = 0
+
+
+class NoStalls(PsaCwaPolicy):
+    """Ablation: done at the first scan that finds nothing new (and bump marks kept)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.max_stalls = 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ablation", [NoVotes, NoStalls, PsaCwaDeadReckoningPolicy])
+def test_each_mechanism_earns_its_place(ablation) -> None:
+    """Shipped maps, seeds 0-2; measured mean (min) coverage at done: 94.2 % (69.3 %)
+    with all; 90.4 % (67.9 %) without votes; 87.1 % (30.2 %) without the stall rule."""
+    ours, theirs = [], []
+    for map_name in ("room", "apartment", "maze"):
+        for seed in range(3):
+            ours.append(coverage_at_done(PsaCwaPolicy, seed, map_name=map_name, **NOISE)[0])
+            theirs.append(coverage_at_done(ablation, seed, map_name=map_name, **NOISE)[0])
+    assert np.mean(ours) > np.mean(theirs) + 0.02
+    assert np.min(ours) >= np.min(theirs)
