@@ -42,7 +42,7 @@ import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
 from motiongym.agents.reproduce import sweeper_odometry
-from motiongym.baselines.sweeper.run import make_policy, run_episode
+from motiongym.agents.sweeper_runs import run_sweep, sweeper_policy
 from motiongym.envs.sweeper import generator, maps, occupancy
 
 ENV_ID = "motiongym/Sweeper-v0"
@@ -63,8 +63,8 @@ def _env(**kwargs: Any) -> gym.Env:
 
 def _episode(env: gym.Env, policy: str, seed: int | None, options=None, max_steps=None) -> dict:
     kwargs = {**gym.spec(ENV_ID).kwargs, "robot_width": W}
-    out = run_episode(env, make_policy(policy, env, kwargs), seed, options, max_steps)
-    out.pop("memory")
+    out = run_sweep(env, sweeper_policy(policy, env, kwargs), seed, options, max_steps)
+    out.pop("transfers")
     return out
 
 

@@ -14,7 +14,9 @@ POLICIES: dict[str, dict[str, str]] = {
     "motiongym/Sweeper-v1": dict(_SWEEPER_POLICIES),
 }
 
-# Planning times of `motiongym bench`: label -> ("module:function", goal in s).
+# Planning times of `motiongym bench`: label -> ("module:function", goal in s). PSA + CWA
+# plans online, while it senses: its "plan" is a whole run, timed through the one episode
+# loop (agents.sweeper_runs; a name the bench resolves, not an import of this package).
 PLANNERS: dict[str, tuple[str, float | None]] = {
-    "PSA + CWA, full run on the maze": ("motiongym.baselines.sweeper.run:sweep", 2.0),
+    "PSA + CWA, full run on the maze": ("motiongym.agents.sweeper_runs:sweep", 2.0),
 }

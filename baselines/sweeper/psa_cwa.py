@@ -118,14 +118,16 @@ class PsaCwaPolicy(ScriptedPolicy):
     def describe(self, memory: Memory) -> dict[str, Any]:
         """``mode`` (the algorithm's step), ``done`` (True once it has declared the
         area swept: its map holds no reachable floor unswept or unknown), ``pose``
-        (the cell it believes its footprint at) and ``spread`` (the localiser's
-        position spread in cells, 0.0 without one)."""
+        (the cell it believes its footprint at), ``spread`` (the localiser's
+        position spread in cells, 0.0 without one) and ``log`` (its transfers,
+        restarts and corner moves so far: ``(kind, from cell, to cell)``)."""
         m = memory
         return {
             "mode": m.mode,
             "done": m.mode == "done",
             "pose": m.last_pose,
             "spread": m.loc.spread if m.loc is not None else 0.0,
+            "log": list(m.log),
         }
 
     # ----------------------------------------------------------------- acting

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
+from motiongym.agents.sweeper_runs import run_sweep, sweep
 from motiongym.baselines.registry import make_policy, scripted_policies
-from motiongym.baselines.sweeper.run import run_episode, sweep
 from motiongym.envs.sweeper.generator import empty_room
 
 ENV_ID = "motiongym/Sweeper-v0"
@@ -33,7 +33,7 @@ def _procedural(n: int, first_seed: int) -> None:
     kwargs = {**gym.spec(ENV_ID).kwargs, "map_name": "random"}
     policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, kwargs)
     for seed in range(first_seed, first_seed + n):
-        info = run_episode(env, policy, seed)
+        info = run_sweep(env, policy, seed)
         assert info["is_success"], (seed, info["coverage"])
 
 
@@ -141,9 +141,9 @@ def test_region_behind_the_last_lane_is_pushed_and_swept_by_psa() -> None:
     options = {"start": (7, 1), "heading": 3}
     env = gym.make(ENV_ID, grid=grid)
     policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, {})
-    info = run_episode(env, policy, 0, options)
+    info = run_sweep(env, policy, 0, options)
     assert info["is_success"]
-    assert info["memory"].log == [("transfer", (12, 13), (6, 13))]  # popped from the stack
+    assert info["transfers"] == [("transfer", (12, 13), (6, 13))]  # popped from the stack
     policy.push_behind = False
-    info = run_episode(env, policy, 0, options)
-    assert info["memory"].log == [("restart", (12, 13), (4, 13))]  # found by CWA's scan
+    info = run_sweep(env, policy, 0, options)
+    assert info["transfers"] == [("restart", (12, 13), (4, 13))]  # found by CWA's scan

@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
+from motiongym.agents.sweeper_runs import run_sweep, sweep
 from motiongym.baselines.registry import make_policy
-from motiongym.baselines.sweeper.run import run_episode, sweep
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.generator import empty_room
 
@@ -35,7 +35,7 @@ def _ratios(map_name: str, seeds: range) -> tuple[np.ndarray, np.ndarray]:
     policy = make_policy(ENV_ID, "psa-cwa", env.observation_space, env.action_space, kwargs)
     ours, bound = [], []
     for seed in seeds:
-        info = run_episode(env, policy, seed)
+        info = run_sweep(env, policy, seed)
         assert info["is_success"], (map_name, seed)
         sc = env.unwrapped.scenario
         ours.append(info["travel_ratio"])
@@ -67,7 +67,7 @@ def test_first_shift_takes_the_open_side() -> None:
     # the whole room (18 rows = 6 lanes), with no transfer at all
     info = sweep("room", grid=empty_room(20, 26), options={"start": (1, 22), "heading": 2})
     assert info["is_success"]
-    assert info["memory"].log == []
+    assert info["transfers"] == []
     assert info["travel_by_mode"]["transfer"] == 0.0
     assert info["travel_ratio"] < 1.0  # shifts sweep too
 
@@ -78,7 +78,7 @@ def test_popped_segments_leave_no_wide_region_to_corner_work() -> None:
     for seed in range(4):
         info = sweep("maze", seed=seed)
         assert info["psa_coverage"] == 1.0
-        assert not [e for e in info["memory"].log if e[0] == "restart"]
+        assert not [e for e in info["transfers"] if e[0] == "restart"]
 
 
 @pytest.mark.parametrize(
