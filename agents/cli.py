@@ -62,6 +62,14 @@ def _folder(text: str) -> Path:
     return path
 
 
+def _file(text: str) -> Path:
+    """An output file: it may not exist yet, but may not be a folder."""
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+    return path
+
+
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
     """``["dof=5", "map_name=maze"]`` -> ``{"dof": 5, "map_name": "maze"}`` (values as YAML)."""
     kwargs = {}
@@ -69,7 +77,11 @@ def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
         key, sep, value = pair.partition("=")
         if not sep or not key:
             raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair!r}")
-        kwargs[key] = yaml.safe_load(value)
+        try:
+            kwargs[key] = yaml.safe_load(value)
+        except yaml.YAMLError as error:
+            problem = getattr(error, "problem", None) or type(error).__name__
+            raise UsageError(f"--env-kwargs {pair!r}: the value is not YAML ({problem})") from None
     return kwargs
 
 
@@ -275,7 +287,7 @@ def build_parser() -> argparse.ArgumentParser:
     benchmarks.add_argument(
         "--episodes", type=_count, default=20, help="held-out episodes (default 20)"
     )
-    benchmarks.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
+    benchmarks.add_argument("--out", type=_file, default=Path("BENCHMARKS.md"))
     benchmarks.set_defaults(handler=cmd_benchmarks)
 
     reproduce = commands.add_parser("reproduce", help="a paper's evaluation beside its figures")

@@ -79,6 +79,20 @@ def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
     return kwargs
 
 
+class PlainCheckpoints(CheckpointCallback):
+    """SB3's checkpoints, with the normalisation statistics beside each as plain
+    arrays (``model_vecnormalize_<steps>_steps.npz``), never SB3's pickle."""
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.save_freq == 0:
+            self.model.save(self._checkpoint_path(extension="zip"))
+            normalization = self.model.get_vec_normalize_env()
+            if normalization is not None:
+                path = self._checkpoint_path("vecnormalize_", extension="npz")
+                save_normalization(normalization, Path(path))
+        return True
+
+
 def _monitored(venv, monitor_dir: Path | None, name: str) -> VecMonitor:
     """``venv`` recording its episodes in ``monitor_dir/<name>.monitor.csv`` (if a folder)."""
     if monitor_dir:
@@ -160,8 +174,12 @@ def train(
         config["n_timesteps"] = n_timesteps
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
-    run_dir.mkdir(parents=True, exist_ok=True)
-    try:  # a run that fails before learning leaves no half-made folder
+    made = [p for p in (run_dir, *run_dir.parents) if not p.exists()]  # deepest first
+    try:
+        run_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise UsageError(f"cannot make the run folder {run_dir}: {error.strerror}") from None
+    try:  # a run that fails before learning leaves no half-made folder (nor its parents)
         (run_dir / "command.txt").write_text(shlex.join(sys.argv) + "\n")
         resolved = {"env_id": env_id, "algo": algo, "seed": seed, "config_file": str(config_path)}
         (run_dir / CONFIG_FILE).write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
@@ -186,7 +204,7 @@ def train(
                 verbose=0,
                 **algorithm_kwargs(config),
             )
-        except AssertionError as error:  # SB3 checks the spaces with assertions
+        except (AssertionError, ValueError) as error:  # SB3 checks spaces and policy
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
         eval_dir = run_dir / "eval"
         if algo == "maskableppo":
@@ -206,15 +224,17 @@ def train(
                 deterministic=config["deterministic"],
                 verbose=0,
             ),
-            CheckpointCallback(
+            PlainCheckpoints(
                 save_freq=max(config["checkpoint_freq"] // venv.num_envs, 1),
                 save_path=str(run_dir / "checkpoints"),
                 name_prefix="model",
-                save_vecnormalize=bool(config["normalize"]),
             ),
         ]
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
+        for folder in made[1:]:  # the parents this run made, if left empty
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
         raise
     model.learn(
         total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress

@@ -110,8 +110,8 @@ def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
     config = tmp_path / "tiny.yml"
     config.write_text(
         "ppo:\n  n_envs: 2\n  n_timesteps: 128\n  policy: MultiInputPolicy\n  n_steps: 64\n"
-        "  batch_size: 64\n  eval_freq: 64\n  n_eval_episodes: 1\n"
-        "  env_kwargs: {map_name: room, max_episode_steps: 100}\n"
+        "  batch_size: 64\n  eval_freq: 64\n  n_eval_episodes: 1\n  checkpoint_freq: 64\n"
+        "  normalize: true\n  env_kwargs: {map_name: room, max_episode_steps: 100}\n"
     )
     argv = ["train", SWEEPER, "--config", str(config), "--out", str(tmp_path), "--no-progress"]
     assert main(argv) == 0
@@ -128,6 +128,9 @@ def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
     ):
         assert (run_dir / name).exists(), name
     assert yaml.safe_load((run_dir / "config.yml").read_text())["n_steps"] == 64
+    assert (run_dir / "vecnormalize.npz").is_file()  # statistics as plain arrays, never pickled
+    assert {p.suffix for p in (run_dir / "checkpoints").iterdir()} == {".npz", ".zip"}
+    assert not list(run_dir.rglob("*.pkl"))
     out = tmp_path / "eval"
     argv = [
         "evaluate",
@@ -211,6 +214,11 @@ def test_train_defaults_to_the_config_files_first_block(tmp_path):
         (["--seed", str(2**32 - 1), "--episodes", "2"], "passes 4294967295"),
         (["--env-kwargs", "map_name=bogus"], "map_name must be one of"),
         (["--env-kwargs", "robot_width=2.5"], "robot_width must be an integer"),
+        (["--env-kwargs", "map_name=[room"], "'map_name=[room': the value is not YAML"),
+        (["--env-kwargs", "max_episode_steps=-3"], "max_episode_steps must be an integer"),
+        (["--env-kwargs", "max_episode_steps=abc"], "max_episode_steps must be an integer"),
+        (["--env-kwargs", "render_mode=bogus"], "render_mode must be one of None"),
+        (["--env-kwargs", "map_file=/nonexistent.txt"], "map_file must be an existing"),
     ],
 )
 def test_bad_evaluation_arguments_are_one_line_and_exit_2(capsys, argv, expected):
@@ -236,6 +244,7 @@ def test_out_on_a_file_is_refused_and_writes_nothing(capsys, tmp_path):
         ("eval_freq: -1", "eval_freq must be an integer >= 1"),
         ("checkpoint_freq: 0", "checkpoint_freq must be an integer >= 1"),
         ("policy_kwargs: {net_arch: [-5]}", "net_arch layer size must be an integer"),
+        ("policy: CnnPolicy", "ppo cannot train on motiongym/Sweeper-v0"),  # SB3's ValueError
     ],
 )
 def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, setting, expected):
@@ -248,4 +257,9 @@ def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, s
     out = tmp_path / "runs"
     err = _error(capsys, ["train", SWEEPER, "--config", str(config), "--out", str(out)])
     assert expected in err
-    assert not out.exists() or not any(out.rglob("*.yml"))
+    assert not out.exists()  # nor the folders above the run's
+
+
+def test_benchmarks_out_on_a_folder_is_refused(capsys, tmp_path):
+    err = _error(capsys, ["benchmarks", "--out", str(tmp_path)])
+    assert "is a folder, not a file" in err
