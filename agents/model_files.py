@@ -56,6 +56,7 @@ RUNTIME_ENTRIES = {  # rollout state, irrelevant to acting: start empty
     "replay_buffer_class": None,
     "action_noise": None,
 }
+MAX_MEMBER_BYTES = 1 << 30  # no archive member unpacks past 1 GiB
 OPTIMIZERS = ("Adam", "AdamW", "RMSprop", "SGD")  # torch.optim classes a policy may name
 
 
@@ -69,7 +70,8 @@ def algorithm_classes() -> dict[str, type[BaseAlgorithm]]:
 
 
 def read_archive_data(path: Path) -> dict[str, Any]:
-    """The archive's ``data`` JSON, after checking its members are the expected ones."""
+    """The archive's ``data`` JSON, after checking its members are the expected ones
+    and that no member unpacks past :data:`MAX_MEMBER_BYTES`."""
     try:
         with zipfile.ZipFile(path) as archive:
             names = archive.namelist()
@@ -78,9 +80,14 @@ def read_archive_data(path: Path) -> dict[str, Any]:
                 raise UsageError(f"{path}: unexpected archive member(s) {unknown}; refused")
             if "data" not in names:
                 raise UsageError(f"{path} is not a Stable-Baselines3 model file (no data entry)")
+            large = [i.filename for i in archive.infolist() if i.file_size > MAX_MEMBER_BYTES]
+            if large:
+                raise UsageError(f"{path}: member(s) {large} unpack past {MAX_MEMBER_BYTES} bytes")
             data = json.loads(archive.read("data"))
-    except (zipfile.BadZipFile, OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise UsageError(f"{path} is not a Stable-Baselines3 model file ({error})") from error
+    except UsageError:
+        raise
+    except Exception as error:  # noqa: BLE001 - any failure to read a file from anyone
+        raise UsageError(f"{path} is not a Stable-Baselines3 model file ({error})") from None
     if not isinstance(data, dict):
         raise UsageError(f"{path}: its data entry is not a JSON object")
     return data
@@ -160,7 +167,7 @@ def _policy_kwargs(path: Path, stored: dict[str, Any], run: dict[str, Any]) -> d
         else:
             try:
                 out[key] = ast.literal_eval(str(text))
-            except (ValueError, SyntaxError):
+            except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
                 raise UsageError(
                     f"{path}: policy_kwargs entry {key!r} is stored as code; load the model "
                     "from its run folder, whose config.yml names it"
@@ -207,7 +214,8 @@ def load_archive(
     serialized = [k for k, v in data.items() if isinstance(v, dict) and ":serialized:" in v]
     if "policy_kwargs" in serialized:
         supply["policy_kwargs"] = _policy_kwargs(path, data["policy_kwargs"], policy_kwargs or {})
-    custom = {key: supply[key] for key in serialized if key in supply}
+    always = ("policy_class", "observation_space", "action_space")  # serialized or not
+    custom = {key: supply[key] for key in (*serialized, *always) if key in supply}
     unknown = sorted(set(serialized) - set(supply))
     if unknown:
         raise UsageError(
@@ -215,9 +223,14 @@ def load_archive(
             f"{unknown} would run code on loading; refused"
         )
     try:
-        return algorithm.load(path, device="cpu", custom_objects=custom)
-    except (RuntimeError, ValueError, KeyError, TypeError) as error:
-        raise UsageError(f"{path}: cannot load its weights ({error})") from error
+        model = algorithm.load(path, device="cpu", custom_objects=custom)
+    except Exception as error:  # noqa: BLE001 - corrupt weights or plain entries from anyone
+        problem = " ".join(str(error).split())[:300]
+        raise UsageError(f"{path}: cannot load it ({type(error).__name__}: {problem})") from None
+    for name, tensor in model.policy.state_dict().items():
+        if tensor.is_floating_point() and not bool(tensor.isfinite().all()):
+            raise UsageError(f"{path}: weights {name} are not finite numbers; refused")
+    return model
 
 
 # ---------------------------------------------------------------- normalisation

@@ -51,6 +51,7 @@ from motiongym.baselines import make_policy, scripted_policies
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yml"
+RUN_RECORD = ("env_id", "algo", "seed", "config_file")  # what train adds to the block
 
 
 class NormalizedModel:
@@ -131,16 +132,32 @@ def run_config(file: Path) -> dict[str, Any]:
         return {}
     try:
         config = yaml.safe_load(config_file.read_text())
-    except yaml.YAMLError as error:
-        raise UsageError(f"{config_file}: not valid YAML ({error})") from error
-    return config if isinstance(config, dict) else {}
+    except (yaml.YAMLError, UnicodeDecodeError) as error:
+        problem = " ".join(str(error).split())
+        raise UsageError(f"{config_file}: not valid YAML ({problem})") from None
+    if not isinstance(config, dict):
+        raise UsageError(f"{config_file} must be a mapping of the run's settings")
+    return validated_run_config(config, config_file)
+
+
+def validated_run_config(config: dict[str, Any], config_file: Path) -> dict[str, Any]:
+    """A run's resolved ``config.yml`` checked as a configuration block is
+    (:func:`motiongym.agents.config.validate_block`), its ``algo`` among ours."""
+    from motiongym.agents.config import validate_block
+
+    block = {k: v for k, v in config.items() if k not in RUN_RECORD}
+    algo = config.get("algo")
+    if not isinstance(algo, str):
+        raise UsageError(f"{config_file}: 'algo' must name an algorithm, got {algo!r}")
+    return {**config, **validate_block(block, algo, str(config_file))}
 
 
 def check_provenance(file: Path, trust: bool) -> None:
-    """Verify the manifest of the folder holding ``file``; without one, require ``trust``."""
+    """Verify the manifest of the folder holding ``file`` (it must list ``file`` and
+    every other file the loader reads); without one, require ``trust``."""
     folder = file.parent
     if (folder / MANIFEST).is_file():
-        verify_manifest(folder)
+        verify_manifest(folder, (file.name, NORMALIZATION_FILE, CONFIG_FILE))
         return
     if not trust:
         raise UsageError(

@@ -7,6 +7,7 @@ every test asserts that the file never appears.
 from __future__ import annotations
 
 import base64
+import io
 import json
 import os
 import pickle
@@ -138,3 +139,48 @@ def test_a_truncated_archive_is_one_clear_error(folder):
     (folder / "manifest.json").unlink()
     with pytest.raises(UsageError, match="not a Stable-Baselines3 model"):
         _load(folder, trust=True)
+
+
+def test_a_manifest_must_list_the_files_it_vouches_for(folder):
+    manifest = folder / "manifest.json"
+    digests = json.loads(manifest.read_text())
+    del digests["model.zip"]  # a manifest that leaves the model out verifies nothing
+    manifest.write_text(json.dumps(digests))
+    with pytest.raises(UsageError, match="does not list \\['model.zip'\\]"):
+        _load(folder)
+    for text in ("{not json", "[1, 2]", json.dumps({"../model.zip": "0" * 64})):
+        manifest.write_text(text)
+        with pytest.raises(UsageError, match="manifest.json"):
+            _load(folder)
+
+
+def test_non_finite_weights_are_refused(folder):
+    import torch
+
+    archive = folder / "model.zip"
+    with zipfile.ZipFile(archive) as z:
+        members = {name: z.read(name) for name in z.namelist()}
+    weights = torch.load(io.BytesIO(members["policy.pth"]), weights_only=True)
+    name = next(iter(weights))
+    weights[name] = weights[name].clone().fill_(float("inf"))
+    buffer = io.BytesIO()
+    torch.save(weights, buffer)
+    members["policy.pth"] = buffer.getvalue()
+    with zipfile.ZipFile(archive, "w") as z:
+        for member, content in members.items():
+            z.writestr(member, content)
+    write_manifest(folder)
+    with pytest.raises(UsageError, match=f"weights {name} are not finite"):
+        _load(folder)
+
+
+def test_a_run_config_beside_the_model_is_checked_like_a_config_file(folder):
+    config = folder / "config.yml"
+    config.write_text(config.read_text().replace("net_arch:", "net_arch: 7\n  old_arch:"))
+    write_manifest(folder)
+    with pytest.raises(UsageError, match="net_arch must be a list"):
+        _load(folder)
+    config.write_text("- a list, not a mapping\n")
+    write_manifest(folder)
+    with pytest.raises(UsageError, match="must be a mapping"):
+        _load(folder)
