@@ -85,7 +85,14 @@ class ScriptedPolicy(ABC):
         episode_start: np.ndarray | bool | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """SB3's predictor interface; ``state`` is passed through untouched."""
+        """SB3's predictor interface; ``state`` is passed through untouched.
+
+        ``observation`` must match the observation space (each entry of a Dict
+        space): real numbers of the space's shape, with or without a leading
+        batch axis, all finite; anything else is a ``ValueError`` naming the
+        entry, the shape expected and what was given.
+        """
+        self._check_observation(observation)
         batched = self._is_batched(observation)
         observations = _unbatch(observation) if batched else [observation]
         starts = np.zeros(len(observations), dtype=bool)
@@ -103,12 +110,60 @@ class ScriptedPolicy(ABC):
             return np.stack([np.asarray(a) for a in actions]), state
         return np.asarray(actions[0]), state
 
+    def _check_observation(self, observation: Any) -> None:
+        space = self.observation_space
+        if isinstance(space, spaces.Dict):
+            if not isinstance(observation, dict) or set(observation) != set(space.spaces):
+                shown = sorted(observation) if isinstance(observation, dict) else observation
+                raise ValueError(
+                    f"observation must be a dict with keys {sorted(space.spaces)}, got {shown!r}"
+                )
+            for key, sub in space.spaces.items():
+                _check_entry(f"observation[{key!r}]", observation[key], sub)
+        else:
+            _check_entry("observation", observation, space)
+
     def _is_batched(self, observation: Any) -> bool:
         space = self.observation_space
         if isinstance(space, spaces.Dict):
             key = next(iter(space.spaces))
             return np.ndim(observation[key]) > len(space.spaces[key].shape)
         return np.ndim(observation) > len(space.shape)
+
+
+def _check_entry(name: str, value: Any, space: spaces.Space) -> None:
+    """``value``: finite real numbers of the space's shape, or a batch of them, inside a
+    Box space's bounds (to float32 rounding); else ValueError. A planner fed an
+    observation no environment makes (a path 10**9 long) could plan without end."""
+    shape = space.shape or ()
+    try:
+        a = np.asarray(value)
+    except ValueError:  # ragged
+        a = np.asarray(None)
+    if (
+        a.dtype.kind not in "biuf"
+        or a.ndim not in (len(shape), len(shape) + 1)
+        or a.shape[a.ndim - len(shape) :] != tuple(shape)
+        or (a.ndim > len(shape) and a.shape[0] == 0)
+    ):
+        raise ValueError(
+            f"{name} must be real numbers of shape {tuple(shape)} (or a batch of them), "
+            f"got {type(value).__name__} of shape {a.shape} and dtype {a.dtype}"
+        )
+    if a.dtype.kind == "f" and not np.isfinite(a).all():
+        raise ValueError(f"{name} must be finite (no NaN or inf)")
+    if isinstance(space, spaces.Box):
+        low, high = space.low.astype(np.float64), space.high.astype(np.float64)
+        scale = np.maximum(np.abs(low), np.abs(high))
+        slack = 1e-6 * (1.0 + np.where(np.isfinite(scale), scale, 0.0))
+        outside = (a < low - slack) | (a > high + slack)
+        if outside.any():
+            i = tuple(int(k) for k in np.unravel_index(int(np.flatnonzero(outside)[0]), a.shape))
+            j = i[a.ndim - len(shape) :]
+            raise ValueError(
+                f"{name}{list(i)} = {a[i]:.6g} is outside the observation space's "
+                f"[{low[j]:.6g}, {high[j]:.6g}]"
+            )
 
 
 def _unbatch(observation: Any) -> list[Any]:
