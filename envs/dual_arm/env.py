@@ -10,7 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
-from motiongym.envs.core import check_choice, check_options, check_render_mode
+from motiongym.envs.core import NeedsReset, check_choice, check_options, check_render_mode
 from motiongym.envs.dual_arm import motion
 from motiongym.envs.dual_arm import task as task_module
 from motiongym.envs.dual_arm.params import CONTROLS, WEIGHTS, DualArmParams
@@ -18,7 +18,7 @@ from motiongym.envs.dual_arm.task import DT, TASK_MODES
 from motiongym.envs.dual_arm.world import OBS, DualArmWorld, observation_bounds
 
 
-class DualArmCellEnv(gym.Env):
+class DualArmCellEnv(NeedsReset, gym.Env):
     """Two PUMA-560 arms, each on a fixed pick-and-place trajectory; avoid collisions
     by timing alone (Chang, Chung & Lee: time delay by boundary following).
 
@@ -173,9 +173,11 @@ class DualArmCellEnv(gym.Env):
         self.world.load(*task_module.sample_pair(self.np_random, mode, self.safety_margin))
         self._wait2 = 0.0
         info = self._info(collided=False, terms={k: 0.0 for k in self.weights})
+        self._was_reset = True
         return self.world.observation(), info
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        self._require_reset("step")
         a1, a2 = self._parse(action)
         w = self.world
         if w.p2 < w.n2:  # robot 2 not done before this step
