@@ -315,7 +315,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args.handler(args)
     except (UsageError, UnknownPolicyError, ArgumentError) as error:
-        print(f"motiongym: error: {error}", file=sys.stderr)
+        message = " ".join(str(error).split())  # one line, whatever the message holds
+        print(f"motiongym: error: {message}", file=sys.stderr)
         return 2
     return 0
 

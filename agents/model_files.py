@@ -126,8 +126,17 @@ def check_space(path: Path, data: dict[str, Any], kind: str, space: spaces.Space
         shown = stored.get("spaces") or stored.get("_shape") or stored.get("n")
         raise UsageError(
             f"model {path} was trained for another {kind.replace('_', ' ')}: "
-            f"{stored.get(':type:')} {shown} ({what} has {space})"
+            f"{stored.get(':type:')} {shown} ({what} has {_space_text(space)})"
         )
+
+
+def _space_text(space: spaces.Space) -> str:
+    """A one-line name of ``space``: its class and shape (or its n, or its keys)."""
+    if isinstance(space, spaces.Dict):
+        return f"Dict({', '.join(space.spaces)})"
+    if isinstance(space, spaces.Discrete):
+        return f"Discrete({space.n})"
+    return f"{type(space).__name__}{space.shape}"
 
 
 def _train_freq(stored: dict[str, Any]):

@@ -13,15 +13,14 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
-import os
-from collections import Counter
 
 import gymnasium as gym
 import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings  # noqa: E402
+from fuzzing import OUTCOMES, PROFILE  # noqa: E402
+from hypothesis import given  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 import motiongym  # noqa: E402,F401
@@ -29,14 +28,6 @@ from motiongym.envs import ENV_IDS  # noqa: E402
 from motiongym.envs.excavator.params import DigParams, ReachParams  # noqa: E402
 from motiongym.envs.sweeper.params import SweeperParams  # noqa: E402
 
-settings.register_profile(
-    "fast", max_examples=4, deadline=None, suppress_health_check=list(HealthCheck)
-)
-settings.register_profile(
-    "fuzz", max_examples=60, deadline=None, suppress_health_check=list(HealthCheck)
-)
-PROFILE = os.environ.get("MOTIONGYM_FUZZ", "fast")
-settings.load_profile(PROFILE)
 # The fast slice: the newest version of each world; the full run: every ID.
 FUZZED = (
     ENV_IDS
@@ -48,7 +39,6 @@ FUZZED = (
     )
 )
 
-OUTCOMES: Counter = Counter()
 STEPS = 5
 
 WEIRD = st.one_of(
@@ -161,10 +151,3 @@ def test_actions_are_what_the_space_accepts_or_a_clear_error(env_id, action):
         env.close()
     assert _finite(observation) and math.isfinite(reward)
     OUTCOMES["actions: valid"] += 1
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _print_counts():
-    yield
-    if OUTCOMES:
-        print("\nfuzz outcomes:", ", ".join(f"{k} {v}" for k, v in sorted(OUTCOMES.items())))

@@ -1,0 +1,16 @@
+"""Prints the fuzz suite's counts per outcome (:data:`fuzzing.OUTCOMES`) at the end."""
+
+from __future__ import annotations
+
+import pytest
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _print_counts():
+    yield
+    from fuzzing import OUTCOMES
+
+    if OUTCOMES:
+        print("\nfuzz outcomes:")
+        for key, count in sorted(OUTCOMES.items()):
+            print(f"  {key}: {count}")
