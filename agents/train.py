@@ -53,7 +53,12 @@ from motiongym.agents.config import (
     first_block,
     load_config,
 )
-from motiongym.agents.environments import check_env_id, importable_id, short_name
+from motiongym.agents.environments import (
+    check_env_id,
+    check_make_kwargs,
+    importable_id,
+    short_name,
+)
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
 from motiongym.agents.model_files import (
@@ -65,6 +70,7 @@ from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
 from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE
 from motiongym.agents.pretrained import write_manifest
 from motiongym.agents.vector import VectorEnvAdapter
+from motiongym.envs.core import ArgumentError
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
@@ -172,6 +178,10 @@ def train(
     config = load_config(config_path, algo)
     if n_timesteps is not None:
         config["n_timesteps"] = n_timesteps
+    try:
+        check_make_kwargs(env_id, config["env_kwargs"])
+    except ArgumentError as error:
+        raise UsageError(f"{config_path} [{algo}]: env_kwargs: {error}") from None
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
     made = [p for p in (run_dir, *run_dir.parents) if not p.exists()]  # deepest first
@@ -185,8 +195,12 @@ def train(
         (run_dir / CONFIG_FILE).write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
 
         n_envs = config["n_envs"]
-        venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
-        eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
+        try:  # the environments' own checks of the config's env_kwargs
+            venv = _vec_env(env_id, config, n_envs, seed, run_dir / "monitor")
+            eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
+        except (TypeError, ValueError) as error:
+            raise UsageError(f"{config_path} [{algo}]: env_kwargs: {error}") from None
+        venv = _normalize(venv, config, True)
         eval_venv = _normalize(eval_venv, config, False)
         if algo == "maskableppo" and not venv.has_attr("action_masks"):
             raise UsageError(
@@ -204,7 +218,8 @@ def train(
                 verbose=0,
                 **algorithm_kwargs(config),
             )
-        except (AssertionError, ValueError) as error:  # SB3 checks spaces and policy
+        except (AssertionError, ValueError, TypeError) as error:  # SB3 checks spaces and
+            # policy; a policy_kwargs or features_extractor_kwargs key it lacks is a TypeError
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
         eval_dir = run_dir / "eval"
         if algo == "maskableppo":

@@ -175,8 +175,12 @@ def test_non_finite_weights_are_refused(folder):
 
 
 def test_a_run_config_beside_the_model_is_checked_like_a_config_file(folder):
+    import yaml
+
     config = folder / "config.yml"
-    config.write_text(config.read_text().replace("net_arch:", "net_arch: 7\n  old_arch:"))
+    settings = yaml.safe_load(config.read_text())
+    settings["policy_kwargs"]["net_arch"] = 7
+    config.write_text(yaml.safe_dump(settings))
     write_manifest(folder)
     with pytest.raises(UsageError, match="net_arch must be a list"):
         _load(folder)
