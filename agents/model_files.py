@@ -10,8 +10,9 @@ so nothing in it is unpickled, ever:
   itself through SB3's ``custom_objects`` (the spaces of the environment it
   will act in, the policy class identified by its module and docstring among
   the algorithms' own policy aliases, schedules rebuilt from plain numbers,
-  empty buffers), so SB3 never unpickles. An archive member or a serialized
-  entry we do not know is refused with its name. The weights (``*.pth``)
+  empty buffers), so SB3 never unpickles. An archive member, a serialized
+  entry or a data entry we do not know (not an attribute of the algorithm)
+  is refused with its name. The weights (``*.pth``)
   are read by SB3 with ``torch.load(weights_only=True)``, which refuses
   pickled code.
 * **Observation normalisation** (``vecnormalize.npz``): VecNormalize's
@@ -57,6 +58,16 @@ RUNTIME_ENTRIES = {  # rollout state, irrelevant to acting: start empty
     "action_noise": None,
 }
 MAX_MEMBER_BYTES = 1 << 30  # no archive member unpacks past 1 GiB
+# Entries SB3 writes that a model gets only when set up (with its environment): with
+# the attributes of a model made without setting up, every entry a data JSON may hold.
+SETUP_ENTRIES = {
+    "observation_space",
+    "action_space",
+    "lr_schedule",
+    "n_envs",
+    "exploration_schedule",
+    *(f"{net}batch_norm_stats{t}" for net in ("", "actor_", "critic_") for t in ("", "_target")),
+}
 OPTIMIZERS = ("Adam", "AdamW", "RMSprop", "SGD")  # torch.optim classes a policy may name
 
 
@@ -204,6 +215,10 @@ def load_archive(
     """
     data = read_archive_data(path)
     algorithm, policy = saved_policy(path, data)
+    fresh = algorithm(policy=policy, env=None, device="cpu", _init_setup_model=False)
+    extra = sorted(set(data) - set(fresh.__dict__) - SETUP_ENTRIES)
+    if extra:  # SB3 would set each as an attribute of the model
+        raise UsageError(f"{path}: unknown data entr{'y' if len(extra) == 1 else 'ies'} {extra}")
     check_space(path, data, "observation_space", observation_space, what)
     check_space(path, data, "action_space", action_space, what)
     rate = data.get("learning_rate", 0.0)

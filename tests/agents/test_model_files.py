@@ -82,6 +82,21 @@ def test_an_extra_serialized_entry_in_the_archive_is_refused_by_name(folder, tmp
     assert not marker.exists()
 
 
+def test_an_extra_plain_data_entry_is_refused_by_name(folder):
+    archive = folder / "model.zip"
+    with zipfile.ZipFile(archive) as z:
+        members = {name: z.read(name) for name in z.namelist()}
+    data = json.loads(members["data"])
+    data["predict"] = "a plain entry SB3 would set over the model's method"
+    members["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(archive, "w") as z:
+        for name, content in members.items():
+            z.writestr(name, content)
+    write_manifest(folder)
+    with pytest.raises(UsageError, match=r"unknown data entry \['predict'\]"):
+        _load(folder)
+
+
 def test_a_replaced_serialized_policy_class_is_never_unpickled(folder, tmp_path):
     marker = tmp_path / "marker"
     archive = folder / "model.zip"
