@@ -13,7 +13,7 @@ from motiongym.envs.core import check_int, check_render_mode
 
 def check_env_id(env_id: str) -> str:
     """Return ``env_id`` if Gymnasium knows it, else raise with the valid IDs."""
-    if env_id not in gym.registry:
+    if not isinstance(env_id, str) or env_id not in gym.registry:
         raise UsageError(f"unknown environment ID {env_id!r}; valid IDs: {', '.join(ENV_IDS)}")
     return env_id
 
