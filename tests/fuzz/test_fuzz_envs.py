@@ -53,6 +53,16 @@ WEIRD = st.one_of(
 )
 
 
+# Every world's reset options (and one no world has); values: odd scalars, or vectors and
+# point lists of plausible lengths with odd entries (positions, joint angles, obstacles).
+OPTION_KEYS = ["task", "start", "heading", "fruit", "obstacles", "q", "q0", "target"]
+ODD = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, 0.3, -2.0]))
+VECTORS = st.one_of(
+    st.lists(ODD, min_size=1, max_size=8),
+    st.lists(st.lists(ODD, min_size=3, max_size=4), max_size=40),
+)
+
+
 def keyword_names(env_id: str) -> list[str]:
     """The environment's own keyword arguments (its signature, else its parameters dataclass)."""
     cls = gym.spec(env_id).entry_point
@@ -117,9 +127,7 @@ def test_keyword_arguments_give_a_clear_error_or_a_valid_world(env_id, data):
 @given(
     options=st.one_of(
         WEIRD,
-        st.dictionaries(
-            st.sampled_from(["task", "start", "heading", "x", "target"]), WEIRD, max_size=2
-        ),
+        st.dictionaries(st.sampled_from(OPTION_KEYS), st.one_of(WEIRD, VECTORS), max_size=2),
     )
 )
 def test_reset_options_give_a_clear_error_or_a_valid_reset(env_id, options):
