@@ -8,6 +8,7 @@ standard error that names the problem and the valid choices, and exit code 2.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -55,19 +56,33 @@ def _seed(text: str) -> int:
 
 
 def _folder(text: str) -> Path:
-    """An output folder: it may not exist yet, but may not be a file."""
+    """An output folder: it may not exist yet, but may not be a file, and what of it
+    exists must be a writable folder (checked before any work, not after it)."""
     path = Path(text)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    _check_writable_above(text, path)
     return path
 
 
 def _file(text: str) -> Path:
-    """An output file: it may not exist yet, but may not be a folder."""
+    """An output file: it may not exist yet, but may not be a folder; its folder must
+    be (or be makeable in) a writable folder."""
     path = Path(text)
     if path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+    _check_writable_above(text, path.parent)
     return path
+
+
+def _check_writable_above(text: str, path: Path) -> None:
+    existing = path
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} lies under {str(existing)!r}, a file")
+    if not os.access(existing, os.W_OK):
+        raise argparse.ArgumentTypeError(f"{text!r}: cannot write in {str(existing)!r}")
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:

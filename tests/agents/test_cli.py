@@ -231,6 +231,11 @@ def test_out_on_a_file_is_refused_and_writes_nothing(capsys, tmp_path):
     target.write_text("keep me")
     err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", "--out", str(target)])
     assert "is a file, not a folder" in err and target.read_text() == "keep me"
+    below = str(target / "sub")
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", "--out", below])
+    assert f"lies under {str(target)!r}, a file" in err
+    err = _error(capsys, ["benchmarks", "--out", str(target / "BENCHMARKS.md")])
+    assert "a file" in err
 
 
 @pytest.mark.parametrize(
