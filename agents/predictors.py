@@ -51,6 +51,7 @@ from motiongym.baselines import make_policy, scripted_policies
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yml"
+MAX_TEXT_BYTES = 1 << 20  # config.yml and manifest.json: a run's are a few hundred bytes
 RUN_RECORD = ("env_id", "algo", "seed", "config_file")  # what train adds to the block
 
 
@@ -154,8 +155,17 @@ def validated_run_config(config: dict[str, Any], config_file: Path) -> dict[str,
 
 def check_provenance(file: Path, trust: bool) -> None:
     """Verify the manifest of the folder holding ``file`` (it must list ``file`` and
-    every other file the loader reads); without one, require ``trust``."""
+    every other file the loader reads); without one, require ``trust``. Every file the
+    loader reads must be a regular file, not a link (to a device that never ends, or to
+    a file outside the folder), and the text files at most :data:`MAX_TEXT_BYTES`."""
     folder = file.parent
+    for name in (file.name, NORMALIZATION_FILE, CONFIG_FILE, MANIFEST):
+        path = folder / name
+        if path.is_symlink() or (path.exists() and not path.is_file()):
+            raise UsageError(f"{path} is a link or not a regular file; refused")
+        if name in (CONFIG_FILE, MANIFEST) and path.exists():
+            if path.stat().st_size > MAX_TEXT_BYTES:
+                raise UsageError(f"{path} is larger than {MAX_TEXT_BYTES} bytes; refused")
     if (folder / MANIFEST).is_file():
         verify_manifest(folder, (file.name, NORMALIZATION_FILE, CONFIG_FILE))
         return

@@ -203,3 +203,15 @@ def test_a_run_config_beside_the_model_is_checked_like_a_config_file(folder):
     write_manifest(folder)
     with pytest.raises(UsageError, match="must be a mapping"):
         _load(folder)
+
+
+def test_links_and_oversized_text_files_are_refused(folder, tmp_path):
+    outside = tmp_path / "elsewhere.yml"
+    (folder / "config.yml").rename(outside)
+    (folder / "config.yml").symlink_to(outside)
+    with pytest.raises(UsageError, match="config.yml is a link"):
+        _load(folder, trust=True)
+    (folder / "config.yml").unlink()
+    (folder / "config.yml").write_text("#" * (1 << 21))
+    with pytest.raises(UsageError, match="larger than"):
+        _load(folder, trust=True)
