@@ -53,6 +53,11 @@ WEIRD = st.one_of(
 )
 
 
+# Values a world may well accept, so that combinations get past the first check.
+PLAUSIBLE = st.one_of(
+    st.integers(1, 8), st.floats(0.01, 2.0), st.booleans(), st.sampled_from(["room", "swept"])
+)
+
 # Every world's reset options (and one no world has); values: odd scalars, or vectors and
 # point lists of plausible lengths with odd entries (positions, joint angles, obstacles).
 OPTION_KEYS = ["task", "start", "heading", "fruit", "obstacles", "q", "q0", "target"]
@@ -103,19 +108,21 @@ def _valid_run(env: gym.Env, seed: int) -> None:
 @given(data=st.data())
 def test_keyword_arguments_give_a_clear_error_or_a_valid_world(env_id, data):
     names = keyword_names(env_id)
-    name = data.draw(st.sampled_from(names), label="keyword")
-    value = data.draw(WEIRD, label="value")
+    values = st.one_of(WEIRD, PLAUSIBLE)  # one to three keywords, alone or in conflict
+    kwargs = data.draw(
+        st.dictionaries(st.sampled_from(names), values, min_size=1, max_size=3), label="kwargs"
+    )
     try:
-        env = gym.make(env_id, **{name: value})
+        env = gym.make(env_id, **kwargs)
     except (ValueError, TypeError) as error:
         # the argument, or the one it conflicts with (planar=True with dof=7 names dof)
-        assert any(n in str(error) for n in names), f"{name}={value!r}: {error}"
+        assert any(n in str(error) for n in kwargs), f"{kwargs!r}: {error}"
         OUTCOMES["kwargs: clear error"] += 1
         return
     try:
         _valid_run(env, seed=data.draw(st.integers(0, 2**31), label="seed"))
     except (ValueError, TypeError) as error:  # a choice refused at reset is still named
-        assert any(n in str(error) for n in names), f"{name}={value!r}: {error}"
+        assert any(n in str(error) for n in kwargs), f"{kwargs!r}: {error}"
         OUTCOMES["kwargs: clear error at reset"] += 1
         return
     finally:
