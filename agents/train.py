@@ -70,7 +70,7 @@ from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
 from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE
 from motiongym.agents.pretrained import write_manifest
 from motiongym.agents.vector import VectorEnvAdapter
-from motiongym.envs.core import ArgumentError
+from motiongym.envs.core import ArgumentError, check_int
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
@@ -176,12 +176,12 @@ def train(
     config_path = config_path or default_config_path(env_id)
     algo = algo or first_block(config_path)
     config = load_config(config_path, algo)
-    if n_timesteps is not None:
-        config["n_timesteps"] = n_timesteps
     try:
+        if n_timesteps is not None:  # the config's range (agents/config.py)
+            config["n_timesteps"] = check_int("--timesteps", n_timesteps, 1, 10**11)
         check_make_kwargs(env_id, config["env_kwargs"])
     except ArgumentError as error:
-        raise UsageError(f"{config_path} [{algo}]: env_kwargs: {error}") from None
+        raise UsageError(f"{config_path} [{algo}]: {error}") from None
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
     made = [p for p in (run_dir, *run_dir.parents) if not p.exists()]  # deepest first
@@ -218,8 +218,9 @@ def train(
                 verbose=0,
                 **algorithm_kwargs(config),
             )
-        except (AssertionError, ValueError, TypeError) as error:  # SB3 checks spaces and
-            # policy; a policy_kwargs or features_extractor_kwargs key it lacks is a TypeError
+        except (AssertionError, ValueError, TypeError, RuntimeError) as error:  # SB3's
+            # checks of spaces and policy; a policy_kwargs or features_extractor_kwargs key
+            # it lacks (TypeError) or a layer size torch refuses (RuntimeError)
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
         eval_dir = run_dir / "eval"
         if algo == "maskableppo":

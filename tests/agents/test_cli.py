@@ -250,6 +250,23 @@ def test_out_on_a_file_is_refused_and_writes_nothing(capsys, tmp_path):
         ("checkpoint_freq: 0", "checkpoint_freq must be an integer in [1, "),
         ("policy_kwargs: {net_arch: [-5]}", "net_arch layer size must be an integer"),
         ("policy: CnnPolicy", "ppo cannot train on motiongym/Sweeper-v0"),  # SB3's ValueError
+        ("policy_kwargs: {bogus: 1}", "unknown policy_kwargs key 'bogus'; valid: activation_fn"),
+        ("policy_kwargs: {ortho_init: x}", "policy_kwargs.ortho_init must be True or False"),
+        ("policy_kwargs: {net_arch: {pi: [8], bogus: [8]}}", "net_arch keys must be among"),
+        ("normalize_advantage: 3", "normalize_advantage must be True or False, got 3"),
+        ("ent_coef: auto", "ent_coef must be a finite number"),  # "auto" is SAC's, not PPO's
+        ("n_epochs: 100000000000", "n_epochs must be an integer in [1, 10000]"),
+        ("normalize: {gamma: .nan}", "normalize.gamma must be a finite number"),
+        ("normalize: {clip_obs: -1}", "normalize.clip_obs must be a finite number"),
+        ("normalize: {norm_obs: 5}", "normalize.norm_obs must be True or False"),
+        ("normalize: {bogus: 1}", "unknown normalize key(s) ['bogus']"),
+        ("env_kwargs: {max_episode_steps: -1}", "max_episode_steps must be an integer >= 1"),
+        ("env_kwargs: {coarse: 100000}", "coarse must be an integer in [1, 64]"),
+        (
+            "policy_kwargs: {features_extractor_class: sweeper_egocentric, "
+            "features_extractor_kwargs: {bogus: 1}}",
+            "unexpected keyword argument 'bogus'",
+        ),
     ],
 )
 def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, setting, expected):
