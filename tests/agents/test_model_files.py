@@ -16,6 +16,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from zip_members import rewrite_zip
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
@@ -39,6 +40,24 @@ def folder(tmp_path):
     copy = tmp_path / "run"
     shutil.copytree(pretrained_models(ENV_ID)["ppo"], copy)
     return copy
+
+
+def _rewrite(folder, change):
+    """Apply ``change(members)`` to model.zip's members, then write a matching manifest
+    (as an attacker would)."""
+    rewrite_zip(folder / "model.zip", change)
+    write_manifest(folder)
+
+
+def _set_data(folder, key, value):
+    """model.zip's data JSON with ``key`` set to ``value`` (manifest rewritten)."""
+
+    def change(members):
+        data = json.loads(members["data"])
+        data[key] = value(data.get(key)) if callable(value) else value
+        members["data"] = json.dumps(data).encode()
+
+    _rewrite(folder, change)
 
 
 def _load(path, trust=False):
@@ -66,49 +85,23 @@ def test_a_planted_vecnormalize_pickle_is_never_read(folder, tmp_path):
 
 def test_an_extra_serialized_entry_in_the_archive_is_refused_by_name(folder, tmp_path):
     marker = tmp_path / "marker"
-    archive = folder / "model.zip"
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    data = json.loads(members["data"])
     blob = base64.b64encode(pickle.dumps(Payload(marker))).decode()
-    data["innocent"] = {":type:": "<class 'object'>", ":serialized:": blob}
-    members["data"] = json.dumps(data).encode()
-    with zipfile.ZipFile(archive, "w") as z:
-        for name, content in members.items():
-            z.writestr(name, content)
-    write_manifest(folder)
+    _set_data(folder, "innocent", {":type:": "<class 'object'>", ":serialized:": blob})
     with pytest.raises(UsageError, match="innocent"):
         _load(folder)
     assert not marker.exists()
 
 
 def test_an_extra_plain_data_entry_is_refused_by_name(folder):
-    archive = folder / "model.zip"
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    data = json.loads(members["data"])
-    data["predict"] = "a plain entry SB3 would set over the model's method"
-    members["data"] = json.dumps(data).encode()
-    with zipfile.ZipFile(archive, "w") as z:
-        for name, content in members.items():
-            z.writestr(name, content)
-    write_manifest(folder)
+    _set_data(folder, "predict", "a plain entry SB3 would set over the model's method")
     with pytest.raises(UsageError, match=r"unknown data entry \['predict'\]"):
         _load(folder)
 
 
 def test_a_replaced_serialized_policy_class_is_never_unpickled(folder, tmp_path):
     marker = tmp_path / "marker"
-    archive = folder / "model.zip"
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    data = json.loads(members["data"])
-    data["policy_class"][":serialized:"] = base64.b64encode(pickle.dumps(Payload(marker))).decode()
-    members["data"] = json.dumps(data).encode()
-    with zipfile.ZipFile(archive, "w") as z:
-        for name, content in members.items():
-            z.writestr(name, content)
-    write_manifest(folder)
+    blob = base64.b64encode(pickle.dumps(Payload(marker))).decode()
+    _set_data(folder, "policy_class", lambda entry: {**entry, ":serialized:": blob})
     _load(folder)  # the class is identified from its plain-text module and docstring
     assert not marker.exists()
 
@@ -172,19 +165,15 @@ def test_a_manifest_must_list_the_files_it_vouches_for(folder):
 def test_non_finite_weights_are_refused(folder):
     import torch
 
-    archive = folder / "model.zip"
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    weights = torch.load(io.BytesIO(members["policy.pth"]), weights_only=True)
-    name = next(iter(weights))
-    weights[name] = weights[name].clone().fill_(float("inf"))
-    buffer = io.BytesIO()
-    torch.save(weights, buffer)
-    members["policy.pth"] = buffer.getvalue()
-    with zipfile.ZipFile(archive, "w") as z:
-        for member, content in members.items():
-            z.writestr(member, content)
-    write_manifest(folder)
+    def change(members):
+        weights = torch.load(io.BytesIO(members["policy.pth"]), weights_only=True)
+        weights[name] = weights[name].clone().fill_(float("inf"))
+        buffer = io.BytesIO()
+        torch.save(weights, buffer)
+        members["policy.pth"] = buffer.getvalue()
+
+    name = "mlp_extractor.policy_net.0.weight"
+    _rewrite(folder, change)
     with pytest.raises(UsageError, match=f"weights {name} are not finite"):
         _load(folder)
 

@@ -24,7 +24,6 @@ import json
 import os
 import pickle
 import shutil
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +32,7 @@ import yaml
 from fuzzing import OUTCOMES
 from hypothesis import given
 from hypothesis import strategies as st
+from zip_members import rewrite_zip
 
 from motiongym.agents.config import RUN_SETTINGS, load_config
 from motiongym.agents.environments import make_env
@@ -120,15 +120,6 @@ def test_a_damaged_model_folder_is_a_clear_error_or_a_sound_predictor(
     _outcome(f"model folder, {'flipped' if flip else 'truncated'} {name}", folder, env, trust)
 
 
-def _rewrite_archive(archive: Path, change) -> None:
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    change(members)
-    with zipfile.ZipFile(archive, "w") as z:
-        for name, content in members.items():
-            z.writestr(name, content)
-
-
 def _plant(folder: Path, where: str, key: str, blob: bytes) -> None:
     """Put the pickle ``blob`` at ``where`` in the folder (``key``: which entry)."""
     encoded = base64.b64encode(blob).decode()
@@ -143,13 +134,13 @@ def _plant(folder: Path, where: str, key: str, blob: bytes) -> None:
             data[key] = {**entry, ":type:": "<class 'object'>", ":serialized:": encoded}
             members["data"] = json.dumps(data).encode()
 
-        _rewrite_archive(folder / "model.zip", change)
+        rewrite_zip(folder / "model.zip", change)
     elif where == "weights":
 
         def change(members):
             members["policy.pth"] = blob
 
-        _rewrite_archive(folder / "model.zip", change)
+        rewrite_zip(folder / "model.zip", change)
     elif where == "statistics":
         with np.load(folder / "vecnormalize.npz") as file:
             arrays = {name: file[name] for name in file.files}
