@@ -252,9 +252,17 @@ def train(
             if folder.is_dir() and not any(folder.iterdir()):
                 folder.rmdir()
         raise
-    model.learn(
-        total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
-    )
+    try:
+        model.learn(
+            total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
+        )
+    except (ValueError, RuntimeError, FloatingPointError) as error:  # diverged (NaN logits)
+        problem = " ".join(str(error).split())[:200]
+        raise UsageError(
+            f"training stopped at step {model.num_timesteps} ({problem}); {run_dir} keeps its "
+            "checkpoints and logs but has no model.zip nor manifest.json; lower learning_rate "
+            "or enable normalize"
+        ) from None
     model.save(run_dir / MODEL_FILE)
     if isinstance(venv, VecNormalize):
         save_normalization(venv, run_dir / NORMALIZATION_FILE)

@@ -285,3 +285,19 @@ def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, s
 def test_benchmarks_out_on_a_folder_is_refused(capsys, tmp_path):
     err = _error(capsys, ["benchmarks", "--out", str(tmp_path)])
     assert "is a folder, not a file" in err
+
+
+def test_training_that_diverges_is_one_line_and_says_what_is_left(capsys, tmp_path, monkeypatch):
+    from stable_baselines3 import PPO
+
+    def diverge(self, **kwargs):
+        raise ValueError("Expected parameter logits (Tensor of shape (32, 3)) ... nan")
+
+    monkeypatch.setattr(PPO, "learn", diverge)
+    config = tmp_path / "tiny.yml"
+    config.write_text("ppo:\n  n_timesteps: 64\n  policy: MultiInputPolicy\n  n_steps: 32\n")
+    out = tmp_path / "runs"
+    err = _error(capsys, ["train", SWEEPER, "--config", str(config), "--out", str(out)])
+    assert "training stopped at step 0 (Expected parameter logits" in err
+    (run_dir,) = (out / "Sweeper-v0").iterdir()
+    assert not (run_dir / "manifest.json").exists() and not (run_dir / "model.zip").exists()
