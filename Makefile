@@ -27,10 +27,12 @@ test: $(STAMP)
 test-slow: $(STAMP)
 	MUJOCO_GL=egl $(BIN)/pytest -q -m slow
 
-# The full property-based hostile-input run (every ID, 60 examples per test and ID;
-# the default suite runs a fast slice); prints the counts per outcome.
+# The full property-based hostile-input run (tests/fuzz: every ID's keywords, reset
+# options and actions, the PettingZoo env, the policies' predict, model folders, config
+# files; 60 examples per test and ID; the default suite runs a fast slice); prints the
+# counts per outcome.
 fuzz: $(STAMP)
-	MUJOCO_GL=egl MOTIONGYM_FUZZ=fuzz $(BIN)/pytest -q -s tests/fuzz
+	MUJOCO_GL=egl MOTIONGYM_FUZZ=fuzz $(BIN)/pytest -q -s -W ignore::DeprecationWarning tests/fuzz
 
 # The documentation site (Sphinx, furo): a page per ID from its docstring, the papers,
 # the API reference; warnings are errors. Installs the optional extra `docs` first.

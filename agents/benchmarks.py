@@ -117,6 +117,8 @@ def benchmark_section(env_id: str, n_episodes: int, figures: Path, root: Path) -
         for name in sorted(scripted_policies(env_id))
     ]
     env.close()
+    if not scripted + learned:
+        return f"### {env_id}\n\nNo scripted policy or shipped model yet.\n"
     lines = [f"### {env_id}", "", comparison_markdown(scripted + learned)]
     paper = next(iter(scripted_policies(env_id)), None)  # declared first: the paper's
     reference = None

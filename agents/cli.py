@@ -9,6 +9,7 @@ standard error that names the problem and the valid choices, and exit code 2.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -66,11 +67,33 @@ def _seed(text: str) -> int:
 
 
 def _folder(text: str) -> Path:
-    """An output folder: it may not exist yet, but may not be a file."""
+    """An output folder: it may not exist yet, but may not be a file, and what of it
+    exists must be a writable folder (checked before any work, not after it)."""
     path = Path(text)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    _check_writable_above(text, path)
     return path
+
+
+def _file(text: str) -> Path:
+    """An output file: it may not exist yet, but may not be a folder; its folder must
+    be (or be makeable in) a writable folder."""
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+    _check_writable_above(text, path.parent)
+    return path
+
+
+def _check_writable_above(text: str, path: Path) -> None:
+    existing = path
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} lies under {str(existing)!r}, a file")
+    if not os.access(existing, os.W_OK):
+        raise argparse.ArgumentTypeError(f"{text!r}: cannot write in {str(existing)!r}")
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
@@ -80,7 +103,11 @@ def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
         key, sep, value = pair.partition("=")
         if not sep or not key:
             raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair!r}")
-        kwargs[key] = yaml.safe_load(value)
+        try:
+            kwargs[key] = yaml.safe_load(value)
+        except yaml.YAMLError as error:
+            problem = getattr(error, "problem", None) or type(error).__name__
+            raise UsageError(f"--env-kwargs {pair!r}: the value is not YAML ({problem})") from None
     return kwargs
 
 
@@ -413,7 +440,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--episodes", type=_count, default=20, help="held-out episodes (default 20)"
     )
     benchmarks.add_argument(
-        "--out", type=Path, default=Path("BENCHMARKS.md"), help="file (default BENCHMARKS.md)"
+        "--out", type=_file, default=Path("BENCHMARKS.md"), help="file (default BENCHMARKS.md)"
     )
     benchmarks.set_defaults(handler=cmd_benchmarks)
 
@@ -459,7 +486,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args.handler(args)
     except (UsageError, UnknownPolicyError, ArgumentError) as error:
-        print(f"motiongym: error: {error}", file=sys.stderr)
+        message = " ".join(str(error).split())  # one line, whatever the message holds
+        print(f"motiongym: error: {message}", file=sys.stderr)
         return 2
     return 0
 

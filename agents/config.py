@@ -69,7 +69,7 @@ from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
 from motiongym.agents.model_files import algorithm_classes
-from motiongym.envs.core import ArgumentError, check_choice, check_float, check_int
+from motiongym.envs.core import ArgumentError, check_bool, check_choice, check_float, check_int
 
 RUN_SETTINGS: dict[str, Any] = {
     "n_envs": 1,
@@ -189,18 +189,19 @@ def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
     return config
 
 
-# Ranges of the run settings and of common constructor arguments: key -> check.
+# Ranges of the run settings and of common constructor arguments: key -> check. The
+# upper bounds keep a run's memory and time finite (a 10**12-step rollout buffer).
 _INT_RANGES: dict[str, tuple[int, int | None]] = {
     "n_envs": (1, 1024),
     "n_timesteps": (1, 10**11),
-    "eval_freq": (1, None),
+    "eval_freq": (1, 10**11),
     "n_eval_episodes": (1, 100_000),
-    "checkpoint_freq": (1, None),
-    "n_steps": (2, None),
-    "batch_size": (1, None),
-    "n_epochs": (1, None),
-    "buffer_size": (1, None),
-    "learning_starts": (0, None),
+    "checkpoint_freq": (1, 10**11),
+    "n_steps": (2, 10**7),  # the rollout buffer holds n_steps * n_envs transitions
+    "batch_size": (1, 10**7),
+    "n_epochs": (1, 10_000),
+    "buffer_size": (1, 10**8),
+    "learning_starts": (0, 10**11),
     "sde_sample_freq": (-1, None),
     "stats_window_size": (1, None),
 }
@@ -223,19 +224,29 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
     for key, (low, high, low_open) in _FLOAT_RANGES.items():
         if key in config:
             check_float(key, config[key], low, high, low_open=low_open)
+    params = inspect.signature(algorithm.__init__).parameters
     for key in ("ent_coef", "target_kl", "clip_range_vf"):
         value = config.get(key)
-        if value is not None and not (isinstance(value, str) and value.startswith("auto")):
+        automatic = key in params and isinstance(params[key].default, str)  # SAC's "auto"
+        if value is not None and not (automatic and str(value).startswith("auto")):
             check_float(key, value, 0.0, 1e6)
+    for key, value in config.items():  # a switch is true or false, not a truthy value
+        if key in params and isinstance(params[key].default, bool):
+            check_bool(key, value)
     for key in ("train_freq", "gradient_steps"):
         if key in config and not isinstance(config[key], (list, tuple)):
             check_int(key, config[key], -1 if key == "gradient_steps" else 1)
     check_choice("policy", config["policy"], sorted(algorithm.policy_aliases))
+    _check_policy_kwargs(config["policy_kwargs"], algorithm.policy_aliases[config["policy"]])
     if not (isinstance(config["normalize"], (bool, dict))):
         raise ArgumentError(
             f"normalize must be true, false or a mapping, got {config['normalize']!r}"
         )
+    if isinstance(config["normalize"], dict):
+        _check_normalize(config["normalize"])
     arch = config["policy_kwargs"].get("net_arch")
+    if isinstance(arch, dict) and not set(arch) <= {"pi", "vf", "qf"}:
+        raise ArgumentError(f"net_arch keys must be among pi, vf, qf, got {sorted(arch)}")
     layers = arch.values() if isinstance(arch, dict) else [arch] if arch is not None else []
     for layer in layers:
         if not isinstance(layer, list):
@@ -279,6 +290,47 @@ def _check_replay_buffer(config: dict[str, Any]) -> None:
         raise ArgumentError(
             f"copy_info_dict must be true or false, got {kwargs['copy_info_dict']!r}"
         )
+
+
+def _check_policy_kwargs(kwargs: dict[str, Any], policy: type) -> None:
+    """Every key a keyword of the policy class, its switches true or false."""
+    params = inspect.signature(policy.__init__).parameters
+    if any(p.kind == p.VAR_KEYWORD for p in params.values()):
+        return
+    valid = sorted(set(params) - {"self", "observation_space", "action_space", "lr_schedule"})
+    for key, value in kwargs.items():
+        if key not in valid:
+            raise ArgumentError(f"unknown policy_kwargs key {key!r}; valid: {', '.join(valid)}")
+        if isinstance(params[key].default, bool):
+            check_bool(f"policy_kwargs.{key}", value)
+
+
+def _str_list(name: str, value: Any) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise ArgumentError(f"{name} must be a list of observation keys, got {value!r}")
+    return value
+
+
+# VecNormalize's keywords a config's normalize mapping may set: key -> check.
+_NORMALIZE_CHECKS = {
+    "norm_obs": check_bool,
+    "norm_reward": check_bool,
+    "clip_obs": lambda k, v: check_float(k, v, 0.0, 1e6, low_open=True),
+    "clip_reward": lambda k, v: check_float(k, v, 0.0, 1e6, low_open=True),
+    "gamma": lambda k, v: check_float(k, v, 0.0, 1.0, low_open=True),
+    "epsilon": lambda k, v: check_float(k, v, 0.0, 1.0, low_open=True),
+    "norm_obs_keys": _str_list,
+}
+
+
+def _check_normalize(options: dict[str, Any]) -> None:
+    unknown = sorted(set(options) - set(_NORMALIZE_CHECKS), key=str)
+    if unknown:
+        raise ArgumentError(
+            f"unknown normalize key(s) {unknown}; valid: {', '.join(_NORMALIZE_CHECKS)}"
+        )
+    for key, value in options.items():
+        _NORMALIZE_CHECKS[key](f"normalize.{key}", value)
 
 
 def algorithm_kwargs(config: dict[str, Any]) -> dict[str, Any]:

@@ -10,8 +10,9 @@ so nothing in it is unpickled, ever:
   itself through SB3's ``custom_objects`` (the spaces of the environment it
   will act in, the policy class identified by its module and docstring among
   the algorithms' own policy aliases, schedules rebuilt from plain numbers,
-  empty buffers), so SB3 never unpickles. An archive member or a serialized
-  entry we do not know is refused with its name. The weights (``*.pth``)
+  empty buffers), so SB3 never unpickles. An archive member, a serialized
+  entry or a data entry we do not know (not an attribute of the algorithm)
+  is refused with its name. The weights (``*.pth``)
   are read by SB3 with ``torch.load(weights_only=True)``, which refuses
   pickled code.
 * **Observation normalisation** (``vecnormalize.npz``): VecNormalize's
@@ -56,6 +57,17 @@ RUNTIME_ENTRIES = {  # rollout state, irrelevant to acting: start empty
     "replay_buffer_class": None,
     "action_noise": None,
 }
+MAX_MEMBER_BYTES = 1 << 30  # no archive member unpacks past 1 GiB
+# Entries SB3 writes that a model gets only when set up (with its environment): with
+# the attributes of a model made without setting up, every entry a data JSON may hold.
+SETUP_ENTRIES = {
+    "observation_space",
+    "action_space",
+    "lr_schedule",
+    "n_envs",
+    "exploration_schedule",
+    *(f"{net}batch_norm_stats{t}" for net in ("", "actor_", "critic_") for t in ("", "_target")),
+}
 OPTIMIZERS = ("Adam", "AdamW", "RMSprop", "SGD")  # torch.optim classes a policy may name
 
 
@@ -69,7 +81,8 @@ def algorithm_classes() -> dict[str, type[BaseAlgorithm]]:
 
 
 def read_archive_data(path: Path) -> dict[str, Any]:
-    """The archive's ``data`` JSON, after checking its members are the expected ones."""
+    """The archive's ``data`` JSON, after checking its members are the expected ones
+    and that no member unpacks past :data:`MAX_MEMBER_BYTES`."""
     try:
         with zipfile.ZipFile(path) as archive:
             names = archive.namelist()
@@ -78,9 +91,14 @@ def read_archive_data(path: Path) -> dict[str, Any]:
                 raise UsageError(f"{path}: unexpected archive member(s) {unknown}; refused")
             if "data" not in names:
                 raise UsageError(f"{path} is not a Stable-Baselines3 model file (no data entry)")
+            large = [i.filename for i in archive.infolist() if i.file_size > MAX_MEMBER_BYTES]
+            if large:
+                raise UsageError(f"{path}: member(s) {large} unpack past {MAX_MEMBER_BYTES} bytes")
             data = json.loads(archive.read("data"))
-    except (zipfile.BadZipFile, OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise UsageError(f"{path} is not a Stable-Baselines3 model file ({error})") from error
+    except UsageError:
+        raise
+    except Exception as error:  # noqa: BLE001 - any failure to read a file from anyone
+        raise UsageError(f"{path} is not a Stable-Baselines3 model file ({error})") from None
     if not isinstance(data, dict):
         raise UsageError(f"{path}: its data entry is not a JSON object")
     return data
@@ -127,8 +145,17 @@ def check_space(path: Path, data: dict[str, Any], kind: str, space: spaces.Space
         shown = stored.get("spaces") or stored.get("_shape") or stored.get("n")
         raise UsageError(
             f"model {path} was trained for another {kind.replace('_', ' ')}: "
-            f"{stored.get(':type:')} {shown} ({what} has {space})"
+            f"{stored.get(':type:')} {shown} ({what} has {_space_text(space)})"
         )
+
+
+def _space_text(space: spaces.Space) -> str:
+    """A one-line name of ``space``: its class and shape (or its n, or its keys)."""
+    if isinstance(space, spaces.Dict):
+        return f"Dict({', '.join(space.spaces)})"
+    if isinstance(space, spaces.Discrete):
+        return f"Discrete({space.n})"
+    return f"{type(space).__name__}{space.shape}"
 
 
 def _train_freq(stored: dict[str, Any]):
@@ -168,7 +195,7 @@ def _policy_kwargs(path: Path, stored: dict[str, Any], run: dict[str, Any]) -> d
         else:
             try:
                 out[key] = ast.literal_eval(str(text))
-            except (ValueError, SyntaxError):
+            except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
                 raise UsageError(
                     f"{path}: policy_kwargs entry {key!r} is stored as code; load the model "
                     "from its run folder, whose config.yml names it"
@@ -196,6 +223,10 @@ def load_archive(
     """
     data = read_archive_data(path)
     algorithm, policy = saved_policy(path, data)
+    fresh = algorithm(policy=policy, env=None, device="cpu", _init_setup_model=False)
+    extra = sorted(set(data) - set(fresh.__dict__) - SETUP_ENTRIES)
+    if extra:  # SB3 would set each as an attribute of the model
+        raise UsageError(f"{path}: unknown data entr{'y' if len(extra) == 1 else 'ies'} {extra}")
     check_space(path, data, "observation_space", observation_space, what)
     check_space(path, data, "action_space", action_space, what)
     rate = data.get("learning_rate", 0.0)
@@ -215,7 +246,8 @@ def load_archive(
     serialized = [k for k, v in data.items() if isinstance(v, dict) and ":serialized:" in v]
     if "policy_kwargs" in serialized:
         supply["policy_kwargs"] = _policy_kwargs(path, data["policy_kwargs"], policy_kwargs or {})
-    custom = {key: supply[key] for key in serialized if key in supply}
+    always = ("policy_class", "observation_space", "action_space")  # serialized or not
+    custom = {key: supply[key] for key in (*serialized, *always) if key in supply}
     if data.get("replay_buffer_kwargs"):  # HER's keywords: no replay buffer is needed to act
         custom["replay_buffer_kwargs"] = {}
     unknown = sorted(set(serialized) - set(supply))
@@ -225,9 +257,14 @@ def load_archive(
             f"{unknown} would run code on loading; refused"
         )
     try:
-        return algorithm.load(path, device="cpu", custom_objects=custom)
-    except (RuntimeError, ValueError, KeyError, TypeError) as error:
-        raise UsageError(f"{path}: cannot load its weights ({error})") from error
+        model = algorithm.load(path, device="cpu", custom_objects=custom)
+    except Exception as error:  # noqa: BLE001 - corrupt weights or plain entries from anyone
+        problem = " ".join(str(error).split())[:300]
+        raise UsageError(f"{path}: cannot load it ({type(error).__name__}: {problem})") from None
+    for name, tensor in model.policy.state_dict().items():
+        if tensor.is_floating_point() and not bool(tensor.isfinite().all()):
+            raise UsageError(f"{path}: weights {name} are not finite numbers; refused")
+    return model
 
 
 # ---------------------------------------------------------------- normalisation

@@ -59,6 +59,8 @@ from motiongym.baselines import make_policy, scripted_policies
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yml"
+MAX_TEXT_BYTES = 1 << 20  # config.yml and manifest.json: a run's are a few hundred bytes
+RUN_RECORD = ("env_id", "algo", "seed", "config_file")  # what train adds to the block
 RANDOM = "random"
 
 
@@ -164,16 +166,41 @@ def run_config(file: Path) -> dict[str, Any]:
         return {}
     try:
         config = yaml.safe_load(config_file.read_text())
-    except yaml.YAMLError as error:
-        raise UsageError(f"{config_file}: not valid YAML ({error})") from error
-    return config if isinstance(config, dict) else {}
+    except (yaml.YAMLError, UnicodeDecodeError) as error:
+        problem = " ".join(str(error).split())
+        raise UsageError(f"{config_file}: not valid YAML ({problem})") from None
+    if not isinstance(config, dict):
+        raise UsageError(f"{config_file} must be a mapping of the run's settings")
+    return validated_run_config(config, config_file)
+
+
+def validated_run_config(config: dict[str, Any], config_file: Path) -> dict[str, Any]:
+    """A run's resolved ``config.yml`` checked as a configuration block is
+    (:func:`motiongym.agents.config.validate_block`), its ``algo`` among ours."""
+    from motiongym.agents.config import validate_block
+
+    block = {k: v for k, v in config.items() if k not in RUN_RECORD}
+    algo = config.get("algo")
+    if not isinstance(algo, str):
+        raise UsageError(f"{config_file}: 'algo' must name an algorithm, got {algo!r}")
+    return {**config, **validate_block(block, algo, str(config_file))}
 
 
 def check_provenance(file: Path, trust: bool) -> None:
-    """Verify the manifest of the folder holding ``file``; without one, require ``trust``."""
+    """Verify the manifest of the folder holding ``file`` (it must list ``file`` and
+    every other file the loader reads); without one, require ``trust``. Every file the
+    loader reads must be a regular file, not a link (to a device that never ends, or to
+    a file outside the folder), and the text files at most :data:`MAX_TEXT_BYTES`."""
     folder = file.parent
+    for name in (file.name, NORMALIZATION_FILE, CONFIG_FILE, MANIFEST):
+        path = folder / name
+        if path.is_symlink() or (path.exists() and not path.is_file()):
+            raise UsageError(f"{path} is a link or not a regular file; refused")
+        if name in (CONFIG_FILE, MANIFEST) and path.exists():
+            if path.stat().st_size > MAX_TEXT_BYTES:
+                raise UsageError(f"{path} is larger than {MAX_TEXT_BYTES} bytes; refused")
     if (folder / MANIFEST).is_file():
-        verify_manifest(folder)
+        verify_manifest(folder, (file.name, NORMALIZATION_FILE, CONFIG_FILE))
         return
     if not trust:
         raise UsageError(

@@ -41,12 +41,34 @@ def write_manifest(folder: Path) -> Path:
     return path
 
 
-def verify_manifest(folder: Path) -> None:
-    """Raise :class:`UsageError` unless every file matches the manifest."""
+def verify_manifest(folder: Path, required: tuple[str, ...] = ()) -> None:
+    """Raise :class:`UsageError` unless every file matches the manifest.
+
+    The manifest must be a JSON object of plain file names (no folder parts)
+    to SHA-256 hex digests, and must list every file of ``required`` that
+    exists (the files about to be read): a manifest that leaves out the model
+    verifies nothing.
+    """
     manifest = folder / MANIFEST
     if not manifest.is_file():
         raise UsageError(f"{folder} has no {MANIFEST}")
-    for name, digest in json.loads(manifest.read_text()).items():
+    try:
+        digests = json.loads(manifest.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise UsageError(f"{manifest} is not JSON ({error})") from None
+    if not isinstance(digests, dict) or not all(
+        isinstance(n, str)
+        and Path(n).name == n
+        and n not in ("", ".", "..")
+        and isinstance(d, str)
+        and len(d) == 64
+        for n, d in digests.items()
+    ):
+        raise UsageError(f"{manifest} must map plain file names to SHA-256 hex digests")
+    unlisted = [name for name in required if (folder / name).exists() and name not in digests]
+    if unlisted:
+        raise UsageError(f"{manifest} does not list {unlisted}; refused")
+    for name, digest in digests.items():
         path = folder / name
         if not path.is_file():
             raise UsageError(f"{path} is listed in {manifest} but missing")

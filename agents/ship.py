@@ -13,12 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
-from motiongym.agents.environments import make_env, short_name
+from motiongym.agents.environments import check_env_id, make_env, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import EVALUATION_SEED, Evaluation, evaluate
-from motiongym.agents.predictors import load_model
+from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE, load_model, run_config
 from motiongym.agents.pretrained import (
     LEARNING_CURVES,
     METRICS,
@@ -35,10 +34,15 @@ def shipped_label(config: dict) -> str:
 
 
 def _run_config(run_dir: Path) -> dict:
-    config_file = run_dir / "config.yml"
+    """The run's ``config.yml``, validated as the loaders do, with its ID and seed."""
+    config_file = run_dir / CONFIG_FILE
     if not config_file.is_file():
         raise UsageError(f"{run_dir} is not a training run folder (no config.yml)")
-    return yaml.safe_load(config_file.read_text())
+    config = run_config(run_dir / MODEL_FILE)
+    check_env_id(config.get("env_id"))
+    if isinstance(config.get("seed"), bool) or not isinstance(config.get("seed"), int):
+        raise UsageError(f"{config_file}: 'seed' must be an integer, got {config.get('seed')!r}")
+    return config
 
 
 def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:

@@ -58,7 +58,12 @@ from motiongym.agents.config import (
     first_block,
     load_config,
 )
-from motiongym.agents.environments import check_env_id, importable_id, short_name
+from motiongym.agents.environments import (
+    check_env_id,
+    check_make_kwargs,
+    importable_id,
+    short_name,
+)
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
 from motiongym.agents.model_files import (
@@ -72,6 +77,7 @@ from motiongym.agents.pretrained import write_manifest
 from motiongym.agents.residual import ResidualWrapper
 from motiongym.agents.vector import VectorEnvAdapter
 from motiongym.baselines import scripted_policies
+from motiongym.envs.core import ArgumentError, check_int
 
 _EVAL_CALLBACK_SEED_OFFSET = 10_000
 
@@ -84,6 +90,20 @@ def policy_kwargs(config: dict[str, Any]) -> dict[str, Any]:
     if "features_extractor_class" in kwargs:
         kwargs["features_extractor_class"] = FEATURES_EXTRACTORS[kwargs["features_extractor_class"]]
     return kwargs
+
+
+class PlainCheckpoints(CheckpointCallback):
+    """SB3's checkpoints, with the normalisation statistics beside each as plain
+    arrays (``model_vecnormalize_<steps>_steps.npz``), never SB3's pickle."""
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.save_freq == 0:
+            self.model.save(self._checkpoint_path(extension="zip"))
+            normalization = self.model.get_vec_normalize_env()
+            if normalization is not None:
+                path = self._checkpoint_path("vecnormalize_", extension="npz")
+                save_normalization(normalization, Path(path))
+        return True
 
 
 def _monitored(venv, monitor_dir: Path | None, name: str) -> VecMonitor:
@@ -225,21 +245,33 @@ def train(
     config_path = config_path or default_config_path(env_id)
     algo = algo or first_block(config_path)
     config = load_config(config_path, algo)
-    if n_timesteps is not None:
-        config["n_timesteps"] = n_timesteps
+    try:
+        if n_timesteps is not None:  # the config's range (agents/config.py)
+            config["n_timesteps"] = check_int("--timesteps", n_timesteps, 1, 10**11)
+        check_make_kwargs(env_id, config["env_kwargs"])
+    except ArgumentError as error:
+        raise UsageError(f"{config_path} [{algo}]: {error}") from None
     _check_her(env_id, config, config_path)
     _check_residual(env_id, config, config_path)
     stamp = time.strftime("%Y%m%d-%H%M%S")
     run_dir = out_root / short_name(env_id) / f"{algo}_seed{seed}_{stamp}"
-    run_dir.mkdir(parents=True, exist_ok=True)
-    try:  # a run that fails before learning leaves no half-made folder
+    made = [p for p in (run_dir, *run_dir.parents) if not p.exists()]  # deepest first
+    try:
+        run_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise UsageError(f"cannot make the run folder {run_dir}: {error.strerror}") from None
+    try:  # a run that fails before learning leaves no half-made folder (nor its parents)
         (run_dir / "command.txt").write_text(shlex.join(sys.argv) + "\n")
         resolved = {"env_id": env_id, "algo": algo, "seed": seed, "config_file": str(config_path)}
         (run_dir / CONFIG_FILE).write_text(yaml.safe_dump({**resolved, **config}, sort_keys=False))
 
         n_envs = config["n_envs"]
-        venv = _normalize(_vec_env(env_id, config, n_envs, seed, run_dir / "monitor"), config, True)
-        eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
+        try:  # the environments' own checks of the config's env_kwargs
+            venv = _vec_env(env_id, config, n_envs, seed, run_dir / "monitor")
+            eval_venv = _vec_env(env_id, config, 1, seed + _EVAL_CALLBACK_SEED_OFFSET, None)
+        except (TypeError, ValueError) as error:
+            raise UsageError(f"{config_path} [{algo}]: env_kwargs: {error}") from None
+        venv = _normalize(venv, config, True)
         eval_venv = _normalize(eval_venv, config, False)
         if algo == "maskableppo" and not venv.has_attr("action_masks"):
             raise UsageError(
@@ -257,7 +289,9 @@ def train(
                 verbose=0,
                 **algorithm_kwargs(config),
             )
-        except AssertionError as error:  # SB3 checks the spaces with assertions
+        except (AssertionError, ValueError, TypeError, RuntimeError) as error:  # SB3's
+            # checks of spaces and policy; a policy_kwargs or features_extractor_kwargs key
+            # it lacks (TypeError) or a layer size torch refuses (RuntimeError)
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
         if config["demonstrations"]:
             _clone(env_id, config, model, venv, seed, run_dir)
@@ -279,19 +313,29 @@ def train(
                 deterministic=config["deterministic"],
                 verbose=0,
             ),
-            CheckpointCallback(
+            PlainCheckpoints(
                 save_freq=max(config["checkpoint_freq"] // venv.num_envs, 1),
                 save_path=str(run_dir / "checkpoints"),
                 name_prefix="model",
-                save_vecnormalize=bool(config["normalize"]),
             ),
         ]
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
+        for folder in made[1:]:  # the parents this run made, if left empty
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
         raise
-    model.learn(
-        total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
-    )
+    try:
+        model.learn(
+            total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
+        )
+    except (ValueError, RuntimeError, FloatingPointError) as error:  # diverged (NaN logits)
+        problem = " ".join(str(error).split())[:200]
+        raise UsageError(
+            f"training stopped at step {model.num_timesteps} ({problem}); {run_dir} keeps its "
+            "checkpoints and logs but has no model.zip nor manifest.json; lower learning_rate "
+            "or enable normalize"
+        ) from None
     model.save(run_dir / MODEL_FILE)
     if isinstance(venv, VecNormalize):
         save_normalization(venv, run_dir / NORMALIZATION_FILE)

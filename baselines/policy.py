@@ -87,7 +87,14 @@ class ScriptedPolicy(ABC):
         episode_start: np.ndarray | bool | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """SB3's predictor interface; ``state`` is passed through untouched."""
+        """SB3's predictor interface; ``state`` is passed through untouched.
+
+        ``observation`` must match the observation space (each entry of a Dict
+        space): real numbers of the space's shape, with or without a leading
+        batch axis, all finite; anything else is a ``ValueError`` naming the
+        entry, the shape expected and what was given.
+        """
+        self._check_observation(observation)
         batched = self._is_batched(observation)
         observations = _unbatch(observation) if batched else [observation]
         starts = np.zeros(len(observations), dtype=bool)
@@ -105,12 +112,94 @@ class ScriptedPolicy(ABC):
             return np.stack([np.asarray(a) for a in actions]), state
         return np.asarray(actions[0]), state
 
+    def _check_observation(self, observation: Any) -> None:
+        checks = self.__dict__.get("_entry_checks") or self._make_entry_checks()
+        if isinstance(self.observation_space, spaces.Dict):
+            if not isinstance(observation, dict) or observation.keys() != checks.keys():
+                shown = sorted(observation) if isinstance(observation, dict) else observation
+                raise ValueError(
+                    f"observation must be a dict with keys {sorted(checks)}, got {shown!r}"
+                )
+            for key, check in checks.items():
+                check.check(observation[key])
+        else:
+            checks[None].check(observation)
+
+    def _make_entry_checks(self) -> dict[Any, _EntryCheck]:
+        """One :class:`_EntryCheck` per entry of the space (key None for a single space),
+        built once: predict pays only the comparisons."""
+        space = self.observation_space
+        if isinstance(space, spaces.Dict):
+            checks = {k: _EntryCheck(f"observation[{k!r}]", sub) for k, sub in space.spaces.items()}
+        else:
+            checks = {None: _EntryCheck("observation", space)}
+        self._entry_checks = checks
+        return checks
+
     def _is_batched(self, observation: Any) -> bool:
         space = self.observation_space
         if isinstance(space, spaces.Dict):
             key = next(iter(space.spaces))
             return np.ndim(observation[key]) > len(space.spaces[key].shape)
         return np.ndim(observation) > len(space.shape)
+
+
+class _EntryCheck:
+    """One observation entry: real numbers of the space's shape, or a batch of them,
+    finite, and inside a Box space's bounds (with slack for float32 rounding); else a
+    ValueError naming the entry. A planner fed an observation no environment makes (a
+    path 10**9 long) could plan without end. The bounds are padded once here, infinite
+    ones replaced by the largest float, so that one pair of comparisons also catches
+    NaN and inf."""
+
+    def __init__(self, name: str, space: spaces.Space) -> None:
+        self.name, self.shape = name, tuple(space.shape or ())
+        self.box = isinstance(space, spaces.Box)
+        if self.box:
+            low, high = space.low.astype(np.float64), space.high.astype(np.float64)
+            scale = np.maximum(np.abs(low), np.abs(high))
+            slack = 1e-6 * (1.0 + np.where(np.isfinite(scale), scale, 0.0))
+            largest = np.finfo(np.float64).max
+            self.low = np.where(np.isfinite(low), low - slack, -largest)
+            self.high = np.where(np.isfinite(high), high + slack, largest)
+
+    def check(self, value: Any) -> None:
+        a = value if type(value) is np.ndarray else _as_array(value)
+        n = len(self.shape)
+        if (
+            a.dtype.kind not in "biuf"
+            or a.ndim not in (n, n + 1)
+            or a.shape[a.ndim - n :] != self.shape
+            or (a.ndim > n and a.shape[0] == 0)
+        ):
+            raise ValueError(
+                f"{self.name} must be real numbers of shape {self.shape} (or a batch of "
+                f"them), got {type(value).__name__} of shape {a.shape} and dtype {a.dtype}"
+            )
+        if self.box:
+            if not ((a >= self.low) & (a <= self.high)).all():
+                self._refuse(a)
+        elif a.dtype.kind == "f" and not np.isfinite(a).all():
+            self._refuse(a)
+
+    def _refuse(self, a: np.ndarray) -> None:
+        if a.dtype.kind == "f" and not np.isfinite(a).all():
+            raise ValueError(f"{self.name} must be finite (no NaN or inf)")
+        outside = (a < self.low) | (a > self.high)
+        i = tuple(int(k) for k in np.unravel_index(int(np.flatnonzero(outside)[0]), a.shape))
+        j = i[a.ndim - len(self.shape) :]
+        low, high = self.low[j], self.high[j]
+        raise ValueError(
+            f"{self.name}{list(i)} = {a[i]:.6g} is outside the observation space's "
+            f"[{low:.6g}, {high:.6g}]"
+        )
+
+
+def _as_array(value: Any) -> np.ndarray:
+    try:
+        return np.asarray(value)
+    except ValueError:  # ragged
+        return np.asarray(None)
 
 
 def _unbatch(observation: Any) -> list[Any]:

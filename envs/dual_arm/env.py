@@ -10,7 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
-from motiongym.envs.core import check_choice, check_options, check_render_mode
+from motiongym.envs.core import NeedsReset, check_choice, check_options, check_render_mode
 from motiongym.envs.dual_arm import motion
 from motiongym.envs.dual_arm import task as task_module
 from motiongym.envs.dual_arm.params import CONTROLS, WEIGHTS, DualArmParams
@@ -19,7 +19,7 @@ from motiongym.envs.dual_arm.world import OBS, DualArmWorld, observation_bounds
 from motiongym.envs.rendering import Renders
 
 
-class DualArmCellEnv(Renders, gym.Env):
+class DualArmCellEnv(NeedsReset, Renders, gym.Env):
     """Two PUMA-560 arms, each on a fixed pick-and-place trajectory; avoid collisions
     by timing alone (Chang, Chung & Lee: time delay by boundary following).
 
@@ -186,10 +186,12 @@ class DualArmCellEnv(Renders, gym.Env):
         self.world.load(*pair)
         self._wait2 = 0.0
         info = self._info(collided=False, terms={k: 0.0 for k in self.weights})
+        self._was_reset = True
         self._show_if_human()
         return self.world.observation(), info
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        self._require_reset("step")
         a1, a2 = self._parse(action)
         w = self.world
         if w.p2 < w.n2:  # robot 2 not done before this step

@@ -8,6 +8,8 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
+from motiongym.envs.actions import checked_box_action
+from motiongym.envs.core import ArgumentError, check_int
 from motiongym.envs.dual_arm.env import OPTIONS, DualArmCellEnv
 
 AGENTS = ("robot_1", "robot_2")
@@ -21,7 +23,10 @@ class DualArmParallelEnv(ParallelEnv):
     both agents see the full observation (94,) and share the reward. Actions:
     Box(0, 1, (1,)) per agent. All agents terminate together (both arms done
     or a collision); truncated together after ``max_steps`` steps (no
-    ``TimeLimit`` wrapper in PettingZoo). Reset options other than ``task`` are
+    ``TimeLimit`` wrapper in PettingZoo; an integer in [1, 10**6]). Each
+    agent's action is checked as the Gymnasium environment checks its own
+    (shape (1,), finite, clipped to [0, 1]); an action for a name that is not
+    an agent is an error naming it. Reset options other than ``task`` are
     ignored (PettingZoo's API test passes arbitrary ones). Other keywords go to the Gymnasium
     environment (``task``, ``safety_margin``, reward weights, ``render_mode``).
     """
@@ -34,9 +39,9 @@ class DualArmParallelEnv(ParallelEnv):
 
     def __init__(self, max_steps: int = 1000, **kwargs: Any) -> None:
         if "control" in kwargs:
-            raise ValueError("control is fixed to 'both' in the parallel environment")
+            raise ArgumentError("control is fixed to 'both' in the parallel environment")
+        self.max_steps = check_int("max_steps", max_steps, 1, 10**6)
         self._env = DualArmCellEnv(control="both", **kwargs)
-        self.max_steps = int(max_steps)
         self.possible_agents = list(AGENTS)
         self.agents: list[str] = []
         self.render_mode = self._env.render_mode
@@ -60,13 +65,17 @@ class DualArmParallelEnv(ParallelEnv):
         return {a: obs.copy() for a in self.agents}, {a: dict(info) for a in self.agents}
 
     def step(self, actions: dict[str, Any]):
+        if not self.agents:
+            raise RuntimeError("no episode under way: call reset() before step()")
+        if not isinstance(actions, dict):
+            raise ArgumentError(f"actions must be a dict {{agent: action}}, got {actions!r}")
         missing = set(self.agents) - set(actions)
         if missing:
-            raise ValueError(f"missing actions for {sorted(missing)}; agents: {self.agents}")
-        a = [np.asarray(actions[name], dtype=np.float32).reshape(-1) for name in AGENTS]
-        for name, v in zip(AGENTS, a, strict=True):
-            if v.shape != (1,):
-                raise ValueError(f"action of {name} must have shape (1,), got {v.shape}")
+            raise ArgumentError(f"missing actions for {sorted(missing)}; agents: {self.agents}")
+        unknown = [name for name in actions if name not in AGENTS]
+        if unknown:
+            raise ArgumentError(f"actions for unknown agent(s) {unknown}; agents: {AGENTS}")
+        a = [checked_box_action(actions[n], (1,), f"the advance of {n}'s arm") for n in AGENTS]
         obs, reward, terminated, _, info = self._env.step(np.concatenate(a))
         self._steps += 1
         truncated = not terminated and self._steps >= self.max_steps

@@ -9,12 +9,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from motiongym.envs.core import check_bool, check_float, check_int
+from motiongym.envs.core import ArgumentError, check_bool, check_float, check_int
 from motiongym.envs.harvest_arm.model import PLANAR_DOFS, SPATIAL_DOFS, ArmSpec, arm_spec
 
 MAX_OBSTACLES = 32  # obstacle slots: L * K explicit contact pairs are evaluated every step
 MAX_RENDER_SIZE = 4096  # pixels per side
 REWARD_TERMS = ("progress", "clearance", "collision", "effort", "success", "distance")
+
+
+def _int_given(name: str, value: object, bounds: tuple[int, ...], given: str) -> int:
+    """``check_int`` over ``bounds[0]..bounds[-1]``, the message also naming the
+    argument that set the range (``given``): a default refused because of it."""
+    try:
+        return check_int(name, value, bounds[0], bounds[-1])
+    except ArgumentError as error:
+        raise ArgumentError(f"{error} (with {given})") from None
 
 
 @dataclass(frozen=True)
@@ -52,7 +61,8 @@ class HarvestArmParams:
     def __post_init__(self) -> None:
         planar = check_bool("planar", self.planar)
         dofs = PLANAR_DOFS if planar else SPATIAL_DOFS
-        dof = dofs[-1] if self.dof is None else check_int("dof", self.dof, dofs[0], dofs[-1])
+        given = f"planar={planar}"
+        dof = dofs[-1] if self.dof is None else _int_given("dof", self.dof, dofs, given)
         n_obstacles = (8 if planar else 10) if self.n_obstacles is None else self.n_obstacles
         n_obstacles = check_int("n_obstacles", n_obstacles, 1, MAX_OBSTACLES)
         n_bars = (0 if planar else 3) if self.n_bars is None else self.n_bars
@@ -60,7 +70,7 @@ class HarvestArmParams:
             "planar": planar,
             "dof": dof,
             "n_obstacles": n_obstacles,
-            "n_bars": check_int("n_bars", n_bars, 0, n_obstacles),
+            "n_bars": _int_given("n_bars", n_bars, (0, n_obstacles), f"n_obstacles={n_obstacles}"),
             "link_radius": check_float("link_radius", self.link_radius, 0.0, 0.1, low_open=True),
             "dt": check_float("dt", self.dt, 0.0, 1.0, low_open=True),
             "safety_distance": check_float(

@@ -110,8 +110,8 @@ def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
     config = tmp_path / "tiny.yml"
     config.write_text(
         "ppo:\n  n_envs: 2\n  n_timesteps: 128\n  policy: MultiInputPolicy\n  n_steps: 64\n"
-        "  batch_size: 64\n  eval_freq: 64\n  n_eval_episodes: 1\n"
-        "  env_kwargs: {map_name: room, max_episode_steps: 100}\n"
+        "  batch_size: 64\n  eval_freq: 64\n  n_eval_episodes: 1\n  checkpoint_freq: 64\n"
+        "  normalize: true\n  env_kwargs: {map_name: room, max_episode_steps: 100}\n"
     )
     argv = ["train", SWEEPER, "--config", str(config), "--out", str(tmp_path), "--no-progress"]
     assert main(argv) == 0
@@ -128,6 +128,9 @@ def test_train_smoke_run_writes_a_loadable_run_folder(capsys, tmp_path):
     ):
         assert (run_dir / name).exists(), name
     assert yaml.safe_load((run_dir / "config.yml").read_text())["n_steps"] == 64
+    assert (run_dir / "vecnormalize.npz").is_file()  # statistics as plain arrays, never pickled
+    assert {p.suffix for p in (run_dir / "checkpoints").iterdir()} == {".npz", ".zip"}
+    assert not list(run_dir.rglob("*.pkl"))
     out = tmp_path / "eval"
     argv = [
         "evaluate",
@@ -221,6 +224,11 @@ def test_train_defaults_to_the_config_files_first_block(tmp_path):
         (["--seed", str(2**32 - 1), "--episodes", "2"], "passes 4294967295"),
         (["--env-kwargs", "map_name=bogus"], "map_name must be one of"),
         (["--env-kwargs", "robot_width=2.5"], "robot_width must be an integer"),
+        (["--env-kwargs", "map_name=[room"], "'map_name=[room': the value is not YAML"),
+        (["--env-kwargs", "max_episode_steps=-3"], "max_episode_steps must be an integer"),
+        (["--env-kwargs", "max_episode_steps=abc"], "max_episode_steps must be an integer"),
+        (["--env-kwargs", "render_mode=bogus"], "render_mode must be one of None"),
+        (["--env-kwargs", "map_file=/nonexistent.txt"], "map_file must be an existing"),
     ],
 )
 def test_bad_evaluation_arguments_are_one_line_and_exit_2(capsys, argv, expected):
@@ -233,6 +241,11 @@ def test_out_on_a_file_is_refused_and_writes_nothing(capsys, tmp_path):
     target.write_text("keep me")
     err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", "--out", str(target)])
     assert "is a file, not a folder" in err and target.read_text() == "keep me"
+    below = str(target / "sub")
+    err = _error(capsys, ["evaluate", SWEEPER, "--policy", "psa-cwa", "--out", below])
+    assert f"lies under {str(target)!r}, a file" in err
+    err = _error(capsys, ["benchmarks", "--out", str(target / "BENCHMARKS.md")])
+    assert "a file" in err
 
 
 @pytest.mark.parametrize(
@@ -243,9 +256,27 @@ def test_out_on_a_file_is_refused_and_writes_nothing(capsys, tmp_path):
         ("policy: 123", "policy must be one of"),
         ("learning_rate: .nan", "learning_rate must be a finite number"),
         ("gamma: 2", "gamma must be a finite number in (0.0, 1.0]"),
-        ("eval_freq: -1", "eval_freq must be an integer >= 1"),
-        ("checkpoint_freq: 0", "checkpoint_freq must be an integer >= 1"),
+        ("eval_freq: -1", "eval_freq must be an integer in [1, "),
+        ("checkpoint_freq: 0", "checkpoint_freq must be an integer in [1, "),
         ("policy_kwargs: {net_arch: [-5]}", "net_arch layer size must be an integer"),
+        ("policy: CnnPolicy", "ppo cannot train on motiongym/Sweeper-v0"),  # SB3's ValueError
+        ("policy_kwargs: {bogus: 1}", "unknown policy_kwargs key 'bogus'; valid: activation_fn"),
+        ("policy_kwargs: {ortho_init: x}", "policy_kwargs.ortho_init must be True or False"),
+        ("policy_kwargs: {net_arch: {pi: [8], bogus: [8]}}", "net_arch keys must be among"),
+        ("normalize_advantage: 3", "normalize_advantage must be True or False, got 3"),
+        ("ent_coef: auto", "ent_coef must be a finite number"),  # "auto" is SAC's, not PPO's
+        ("n_epochs: 100000000000", "n_epochs must be an integer in [1, 10000]"),
+        ("normalize: {gamma: .nan}", "normalize.gamma must be a finite number"),
+        ("normalize: {clip_obs: -1}", "normalize.clip_obs must be a finite number"),
+        ("normalize: {norm_obs: 5}", "normalize.norm_obs must be True or False"),
+        ("normalize: {bogus: 1}", "unknown normalize key(s) ['bogus']"),
+        ("env_kwargs: {max_episode_steps: -1}", "max_episode_steps must be an integer >= 1"),
+        ("env_kwargs: {coarse: 100000}", "coarse must be an integer in [1, 64]"),
+        (
+            "policy_kwargs: {features_extractor_class: sweeper_egocentric, "
+            "features_extractor_kwargs: {bogus: 1}}",
+            "unexpected keyword argument 'bogus'",
+        ),
     ],
 )
 def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, setting, expected):
@@ -258,4 +289,25 @@ def test_bad_config_values_are_named_and_leave_no_run_folder(capsys, tmp_path, s
     out = tmp_path / "runs"
     err = _error(capsys, ["train", SWEEPER, "--config", str(config), "--out", str(out)])
     assert expected in err
-    assert not out.exists() or not any(out.rglob("*.yml"))
+    assert not out.exists()  # nor the folders above the run's
+
+
+def test_benchmarks_out_on_a_folder_is_refused(capsys, tmp_path):
+    err = _error(capsys, ["benchmarks", "--out", str(tmp_path)])
+    assert "is a folder, not a file" in err
+
+
+def test_training_that_diverges_is_one_line_and_says_what_is_left(capsys, tmp_path, monkeypatch):
+    from stable_baselines3 import PPO
+
+    def diverge(self, **kwargs):
+        raise ValueError("Expected parameter logits (Tensor of shape (32, 3)) ... nan")
+
+    monkeypatch.setattr(PPO, "learn", diverge)
+    config = tmp_path / "tiny.yml"
+    config.write_text("ppo:\n  n_timesteps: 64\n  policy: MultiInputPolicy\n  n_steps: 32\n")
+    out = tmp_path / "runs"
+    err = _error(capsys, ["train", SWEEPER, "--config", str(config), "--out", str(out)])
+    assert "training stopped at step 0 (Expected parameter logits" in err
+    (run_dir,) = (out / "Sweeper-v0").iterdir()
+    assert not (run_dir / "manifest.json").exists() and not (run_dir / "model.zip").exists()

@@ -7,6 +7,7 @@ every test asserts that the file never appears.
 from __future__ import annotations
 
 import base64
+import io
 import json
 import os
 import pickle
@@ -15,6 +16,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from zip_members import rewrite_zip
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
@@ -38,6 +40,24 @@ def folder(tmp_path):
     copy = tmp_path / "run"
     shutil.copytree(pretrained_models(ENV_ID)["ppo"], copy)
     return copy
+
+
+def _rewrite(folder, change):
+    """Apply ``change(members)`` to model.zip's members, then write a matching manifest
+    (as an attacker would)."""
+    rewrite_zip(folder / "model.zip", change)
+    write_manifest(folder)
+
+
+def _set_data(folder, key, value):
+    """model.zip's data JSON with ``key`` set to ``value`` (manifest rewritten)."""
+
+    def change(members):
+        data = json.loads(members["data"])
+        data[key] = value(data.get(key)) if callable(value) else value
+        members["data"] = json.dumps(data).encode()
+
+    _rewrite(folder, change)
 
 
 def _load(path, trust=False):
@@ -65,34 +85,23 @@ def test_a_planted_vecnormalize_pickle_is_never_read(folder, tmp_path):
 
 def test_an_extra_serialized_entry_in_the_archive_is_refused_by_name(folder, tmp_path):
     marker = tmp_path / "marker"
-    archive = folder / "model.zip"
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    data = json.loads(members["data"])
     blob = base64.b64encode(pickle.dumps(Payload(marker))).decode()
-    data["innocent"] = {":type:": "<class 'object'>", ":serialized:": blob}
-    members["data"] = json.dumps(data).encode()
-    with zipfile.ZipFile(archive, "w") as z:
-        for name, content in members.items():
-            z.writestr(name, content)
-    write_manifest(folder)
+    _set_data(folder, "innocent", {":type:": "<class 'object'>", ":serialized:": blob})
     with pytest.raises(UsageError, match="innocent"):
         _load(folder)
     assert not marker.exists()
 
 
+def test_an_extra_plain_data_entry_is_refused_by_name(folder):
+    _set_data(folder, "predict", "a plain entry SB3 would set over the model's method")
+    with pytest.raises(UsageError, match=r"unknown data entry \['predict'\]"):
+        _load(folder)
+
+
 def test_a_replaced_serialized_policy_class_is_never_unpickled(folder, tmp_path):
     marker = tmp_path / "marker"
-    archive = folder / "model.zip"
-    with zipfile.ZipFile(archive) as z:
-        members = {name: z.read(name) for name in z.namelist()}
-    data = json.loads(members["data"])
-    data["policy_class"][":serialized:"] = base64.b64encode(pickle.dumps(Payload(marker))).decode()
-    members["data"] = json.dumps(data).encode()
-    with zipfile.ZipFile(archive, "w") as z:
-        for name, content in members.items():
-            z.writestr(name, content)
-    write_manifest(folder)
+    blob = base64.b64encode(pickle.dumps(Payload(marker))).decode()
+    _set_data(folder, "policy_class", lambda entry: {**entry, ":serialized:": blob})
     _load(folder)  # the class is identified from its plain-text module and docstring
     assert not marker.exists()
 
@@ -137,4 +146,61 @@ def test_a_truncated_archive_is_one_clear_error(folder):
     archive.write_bytes(archive.read_bytes()[:500])
     (folder / "manifest.json").unlink()
     with pytest.raises(UsageError, match="not a Stable-Baselines3 model"):
+        _load(folder, trust=True)
+
+
+def test_a_manifest_must_list_the_files_it_vouches_for(folder):
+    manifest = folder / "manifest.json"
+    digests = json.loads(manifest.read_text())
+    del digests["model.zip"]  # a manifest that leaves the model out verifies nothing
+    manifest.write_text(json.dumps(digests))
+    with pytest.raises(UsageError, match="does not list \\['model.zip'\\]"):
+        _load(folder)
+    for text in ("{not json", "[1, 2]", json.dumps({"../model.zip": "0" * 64})):
+        manifest.write_text(text)
+        with pytest.raises(UsageError, match="manifest.json"):
+            _load(folder)
+
+
+def test_non_finite_weights_are_refused(folder):
+    import torch
+
+    def change(members):
+        weights = torch.load(io.BytesIO(members["policy.pth"]), weights_only=True)
+        weights[name] = weights[name].clone().fill_(float("inf"))
+        buffer = io.BytesIO()
+        torch.save(weights, buffer)
+        members["policy.pth"] = buffer.getvalue()
+
+    name = "mlp_extractor.policy_net.0.weight"
+    _rewrite(folder, change)
+    with pytest.raises(UsageError, match=f"weights {name} are not finite"):
+        _load(folder)
+
+
+def test_a_run_config_beside_the_model_is_checked_like_a_config_file(folder):
+    import yaml
+
+    config = folder / "config.yml"
+    settings = yaml.safe_load(config.read_text())
+    settings["policy_kwargs"]["net_arch"] = 7
+    config.write_text(yaml.safe_dump(settings))
+    write_manifest(folder)
+    with pytest.raises(UsageError, match="net_arch must be a list"):
+        _load(folder)
+    config.write_text("- a list, not a mapping\n")
+    write_manifest(folder)
+    with pytest.raises(UsageError, match="must be a mapping"):
+        _load(folder)
+
+
+def test_links_and_oversized_text_files_are_refused(folder, tmp_path):
+    outside = tmp_path / "elsewhere.yml"
+    (folder / "config.yml").rename(outside)
+    (folder / "config.yml").symlink_to(outside)
+    with pytest.raises(UsageError, match="config.yml is a link"):
+        _load(folder, trust=True)
+    (folder / "config.yml").unlink()
+    (folder / "config.yml").write_text("#" * (1 << 21))
+    with pytest.raises(UsageError, match="larger than"):
         _load(folder, trust=True)

@@ -71,10 +71,19 @@ def test_ship_reports_every_seed_and_pools_their_episodes(shipped_folder):
 def test_ship_refuses_runs_of_different_ids(shipped_folder, tmp_path):
     other = tmp_path / "other"
     other.mkdir()
-    (other / "config.yml").write_text("env_id: motiongym/Sweeper-v0\nalgo: ppo\nseed: 0\n")
+    settings = "algo: ppo\nseed: 0\nn_timesteps: 64\npolicy: MultiInputPolicy\n"
+    (other / "config.yml").write_text(f"env_id: motiongym/Sweeper-v0\n{settings}")
     runs = shipped_folder.parent.parent.parent / "runs" / "ExcavatorReach-v0"
     with pytest.raises(UsageError, match="one ID and algorithm"):
         ship([next(runs.iterdir()), other], n_episodes=1, root=tmp_path / "pretrained")
+    for bad, expected in [
+        ("env_id: [1]\n", "unknown environment ID"),
+        ("env_id: motiongym/Sweeper-v0\nseed: x\n", "'seed' must be an integer"),
+        ("env_id: motiongym/Sweeper-v0\nbogus: 1\n", "unknown key 'bogus'"),
+    ]:
+        (other / "config.yml").write_text(bad + settings.replace("seed: 0\n", ""))
+        with pytest.raises(UsageError, match=expected):
+            ship([other], n_episodes=1, root=tmp_path / "pretrained")
 
 
 def test_ship_keeps_a_better_shipped_model_unless_forced(shipped_folder, tmp_path, capsys):

@@ -107,6 +107,14 @@ def test_bad_actions_are_rejected_with_a_message(env_id):
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
+def test_unwrapped_step_before_reset_is_a_clear_error(env_id):
+    env = gym.make(env_id).unwrapped  # without Gymnasium's OrderEnforcing
+    with pytest.raises(RuntimeError, match=r"call reset\(\) before step\(\)"):
+        env.step(env.action_space.sample())
+    env.close()
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
 def test_pickled_environment_continues_identically(env_id):
     env = gym.make(env_id)
     env.reset(seed=1)

@@ -13,15 +13,14 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
-import os
-from collections import Counter
 
 import gymnasium as gym
 import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings  # noqa: E402
+from fuzzing import OUTCOMES, PROFILE  # noqa: E402
+from hypothesis import given  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 import motiongym  # noqa: E402,F401
@@ -29,14 +28,6 @@ from motiongym.envs import ENV_IDS  # noqa: E402
 from motiongym.envs.excavator.params import DigParams, ReachParams  # noqa: E402
 from motiongym.envs.sweeper.params import SweeperParams  # noqa: E402
 
-settings.register_profile(
-    "fast", max_examples=4, deadline=None, suppress_health_check=list(HealthCheck)
-)
-settings.register_profile(
-    "fuzz", max_examples=60, deadline=None, suppress_health_check=list(HealthCheck)
-)
-PROFILE = os.environ.get("MOTIONGYM_FUZZ", "fast")
-settings.load_profile(PROFILE)
 # The fast slice: the newest version of each world; the full run: every ID.
 FUZZED = (
     ENV_IDS
@@ -48,7 +39,6 @@ FUZZED = (
     )
 )
 
-OUTCOMES: Counter = Counter()
 STEPS = 5
 
 WEIRD = st.one_of(
@@ -60,6 +50,21 @@ WEIRD = st.one_of(
     st.text(max_size=5),
     st.lists(st.integers(-3, 3), max_size=3),
     st.complex_numbers(max_magnitude=1e3),
+)
+
+
+# Values a world may well accept, so that combinations get past the first check.
+PLAUSIBLE = st.one_of(
+    st.integers(1, 8), st.floats(0.01, 2.0), st.booleans(), st.sampled_from(["room", "swept"])
+)
+
+# Every world's reset options (and one no world has); values: odd scalars, or vectors and
+# point lists of plausible lengths with odd entries (positions, joint angles, obstacles).
+OPTION_KEYS = ["task", "start", "heading", "fruit", "obstacles", "q", "q0", "target"]
+ODD = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, 0.3, -2.0]))
+VECTORS = st.one_of(
+    st.lists(ODD, min_size=1, max_size=8),
+    st.lists(st.lists(ODD, min_size=3, max_size=4), max_size=40),
 )
 
 
@@ -103,19 +108,21 @@ def _valid_run(env: gym.Env, seed: int) -> None:
 @given(data=st.data())
 def test_keyword_arguments_give_a_clear_error_or_a_valid_world(env_id, data):
     names = keyword_names(env_id)
-    name = data.draw(st.sampled_from(names), label="keyword")
-    value = data.draw(WEIRD, label="value")
+    values = st.one_of(WEIRD, PLAUSIBLE)  # one to three keywords, alone or in conflict
+    kwargs = data.draw(
+        st.dictionaries(st.sampled_from(names), values, min_size=1, max_size=3), label="kwargs"
+    )
     try:
-        env = gym.make(env_id, **{name: value})
+        env = gym.make(env_id, **kwargs)
     except (ValueError, TypeError) as error:
         # the argument, or the one it conflicts with (planar=True with dof=7 names dof)
-        assert any(n in str(error) for n in names), f"{name}={value!r}: {error}"
+        assert any(n in str(error) for n in kwargs), f"{kwargs!r}: {error}"
         OUTCOMES["kwargs: clear error"] += 1
         return
     try:
         _valid_run(env, seed=data.draw(st.integers(0, 2**31), label="seed"))
     except (ValueError, TypeError) as error:  # a choice refused at reset is still named
-        assert any(n in str(error) for n in names), f"{name}={value!r}: {error}"
+        assert any(n in str(error) for n in kwargs), f"{kwargs!r}: {error}"
         OUTCOMES["kwargs: clear error at reset"] += 1
         return
     finally:
@@ -127,9 +134,7 @@ def test_keyword_arguments_give_a_clear_error_or_a_valid_world(env_id, data):
 @given(
     options=st.one_of(
         WEIRD,
-        st.dictionaries(
-            st.sampled_from(["task", "start", "heading", "x", "target"]), WEIRD, max_size=2
-        ),
+        st.dictionaries(st.sampled_from(OPTION_KEYS), st.one_of(WEIRD, VECTORS), max_size=2),
     )
 )
 def test_reset_options_give_a_clear_error_or_a_valid_reset(env_id, options):
@@ -161,10 +166,3 @@ def test_actions_are_what_the_space_accepts_or_a_clear_error(env_id, action):
         env.close()
     assert _finite(observation) and math.isfinite(reward)
     OUTCOMES["actions: valid"] += 1
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _print_counts():
-    yield
-    if OUTCOMES:
-        print("\nfuzz outcomes:", ", ".join(f"{k} {v}" for k, v in sorted(OUTCOMES.items())))
