@@ -382,9 +382,7 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"seed of the first episode; episode i uses seed+i (default {DATASET_SEED}, "
         "clear of the evaluation seeds)",
     )
-    dataset.add_argument(
-        "--env-kwargs", nargs="*", default=[], metavar="KEY=VALUE", help="keywords for gym.make"
-    )
+    _env_kwargs_option(dataset)
     dataset.add_argument(
         "--out", type=_folder, default=Path("datasets"), help="datasets root (default datasets)"
     )

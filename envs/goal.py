@@ -190,7 +190,7 @@ class GoalConditionedEnv(gym.Env):
     Action, termination, reset options, rendering: the base env's.
     """
 
-    metadata = {"render_modes": ["rgb_array"]}  # every base's; an instance has its base's
+    metadata = {"render_modes": ["rgb_array", "human"]}  # every base's; an instance has its base's
 
     def __init__(self, base: str, fields: str, collision: float = 50.0, cost: float = 0.0, **kw):
         self.collision = check_float("collision", collision, 0.0, 1e6)

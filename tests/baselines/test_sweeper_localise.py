@@ -75,7 +75,7 @@ def test_diagnostics_report_done_and_pose() -> None:
     obs, _ = env.reset(seed=0)
     policy.predict(obs, episode_start=np.ones(1, bool))
     d = policy.diagnostics()
-    assert set(d) == {"mode", "done", "pose", "spread"} and d["done"] is False
+    assert set(d) == {"mode", "done", "pose", "spread", "log"} and d["done"] is False
     assert d["pose"] == tuple(int(v) for v in obs["pose"][:2]) and d["spread"] == 0.0
 
 
