@@ -12,7 +12,13 @@ episode_start, deterministic)``: a scripted policy from
   ``motiongym train`` (holding ``model.zip`` and, if the run normalised
   observations, ``vecnormalize.npz``, which is applied here). Nothing in a
   model folder is unpickled (:mod:`motiongym.agents.model_files`); a folder's
-  ``manifest.json`` is verified first, and one without needs ``trust``. A run whose
+  ``manifest.json`` is verified first, and one without needs ``trust``.
+  An rl-zoo3 run (``logs/<algo>/<env-name>_<n>/``, ``<env-name>`` the ID
+  with ``/`` as ``-``) keeps its model in ``<env-name>.zip`` and its
+  normalisation in ``<env-name>/vecnormalize.pkl``, a pickle: it is found
+  and named, and unpickled only with ``trust`` (a pickle runs code when
+  loaded); a model from outside motiongym with no normalisation found is
+  evaluated on raw observations, with a warning that says so. A run whose
   ``config.yml`` says ``vec_env: pettingzoo`` trained one policy for every
   agent; it acts in the single-agent environment through
   :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`. A run whose
@@ -137,16 +143,39 @@ class SampledModel:
 
 
 def model_path(path: Path) -> Path:
-    """The model file of a path that is a ``.zip`` or a run folder."""
+    """The model file of a path that is a ``.zip``, a run folder, or an rl-zoo3 run
+    folder (its final model ``<env-name>.zip``, beside its ``<env-name>/`` folder)."""
     candidate = path / MODEL_FILE if path.is_dir() else path
+    if path.is_dir() and not candidate.is_file():
+        zoo = [z for z in sorted(path.glob("*.zip")) if z.with_suffix("").is_dir()]
+        candidate = zoo[0] if len(zoo) == 1 else candidate
     if not candidate.is_file():
         raise UsageError(f"no model file at {candidate}")
     return candidate
 
 
-def _normalized(model: BaseAlgorithm, file: Path, venv: VecEnv) -> Any:
+def zoo_normalization(file: Path, env_id: str, trust: bool) -> Path | None:
+    """The rl-zoo3 run's ``<env-name>/vecnormalize.pkl`` beside the model ``file``, if
+    any; refused (named, with the reason) unless ``trust``."""
+    pickled = file.parent / env_id.replace("/", "-") / PICKLED_NORMALIZATION
+    if not pickled.is_file():
+        return None
+    if not trust:
+        raise UsageError(
+            f"found the rl-zoo3 run's observation normalisation {pickled}: a pickle, which "
+            "can run any code when loaded, so motiongym loads it only with --trust"
+        )
+    warn(f"unpickling {pickled} (--trust): the rl-zoo3 run's observation normalisation")
+    return pickled
+
+
+def _normalized(model: BaseAlgorithm, file: Path, venv: VecEnv, zoo: Path | None = None) -> Any:
     """``model`` behind the run's saved observation normalisation, if it has one."""
     normalization_file = file.parent / NORMALIZATION_FILE
+    if zoo is not None:  # trusted (zoo_normalization)
+        normalization = VecNormalize.load(str(zoo), venv)
+        normalization.training, normalization.norm_reward = False, False
+        return NormalizedModel(model, normalization)
     if not normalization_file.is_file():
         if (file.parent / PICKLED_NORMALIZATION).is_file():
             raise UsageError(
@@ -169,7 +198,7 @@ def run_config(file: Path) -> dict[str, Any]:
     return config if isinstance(config, dict) else {}
 
 
-def check_provenance(file: Path, trust: bool) -> None:
+def check_provenance(file: Path, trust: bool, unpickles: bool = False) -> None:
     """Verify the manifest of the folder holding ``file``; without one, require ``trust``."""
     folder = file.parent
     if (folder / MANIFEST).is_file():
@@ -180,7 +209,8 @@ def check_provenance(file: Path, trust: bool) -> None:
             f"{folder} has no {MANIFEST} (motiongym train and ship write one); "
             "pass --trust to load it anyway"
         )
-    warn(f"loading {file} without a manifest (--trust); nothing in it is unpickled")
+    if not unpickles:
+        warn(f"loading {file} without a manifest (--trust); nothing in it is unpickled")
 
 
 def _run_policy_kwargs(config: dict[str, Any]) -> dict[str, Any] | None:
@@ -201,7 +231,8 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
     ``deterministic: false`` through :class:`SampledModel`.
     """
     file = model_path(path)
-    check_provenance(file, trust)
+    zoo = zoo_normalization(file, env_id, trust)
+    check_provenance(file, trust, unpickles=zoo is not None)
     config = run_config(file)
     kwargs = _run_policy_kwargs(config)
     if config.get("vec_env") == "pettingzoo":  # one policy shared among the agents
@@ -213,9 +244,16 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
     else:
         what = f"the {env_id} environment"
         model = load_archive(file, env.observation_space, env.action_space, what, kwargs)
-        predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
+        predictor = _normalized(model, file, DummyVecEnv([lambda: env]), zoo)
         if isinstance(model, MaskablePPO):
             predictor = MaskedModel(predictor, env)
+    beside = (file.parent / NORMALIZATION_FILE, file.parent / PICKLED_NORMALIZATION)
+    if not config and zoo is None and not any(f.is_file() for f in beside):
+        warn(
+            f"no observation normalisation found for {file} ({NORMALIZATION_FILE} beside it, "
+            f"or rl-zoo3's {env_id.replace('/', '-')}/{PICKLED_NORMALIZATION}): "
+            "evaluating it on raw observations"
+        )
     if not config.get("deterministic", True):
         predictor = SampledModel(predictor)
     if config.get("residual"):  # the model learned a correction of a scripted policy
