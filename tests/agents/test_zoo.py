@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 from stable_baselines3 import PPO
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
@@ -55,3 +56,44 @@ def test_a_zoo_run_without_normalisation_says_it_found_none(tmp_path, env, capsy
     predictor = load_predictor(str(run / f"{ZOO_NAME}.zip"), ENV_ID, env, trust=True)
     assert isinstance(predictor, PPO)
     assert "no observation normalisation found" in capsys.readouterr().err
+
+
+def test_the_zoo_files_are_made_from_configs_and_hold_only_keys_the_zoo_knows():
+    import inspect
+    from pathlib import Path
+
+    from torch import nn
+
+    from motiongym.agents import zoo
+    from motiongym.agents.model_files import algorithm_classes
+
+    folder = Path(__file__).parents[2] / "configs" / "zoo"
+    assert sorted(p.stem for p in folder.glob("*.yml")) == sorted(zoo.ALGORITHMS)
+    for algo in zoo.ALGORITHMS:
+        text = (folder / f"{algo}.yml").read_text()
+        assert text == zoo.zoo_file(algo), f"configs/zoo/{algo}.yml is stale: regenerate it"
+        constructor = set(inspect.signature(algorithm_classes()[algo].__init__).parameters)
+        for env_id, block in yaml.safe_load(text).items():
+            assert set(block) <= set(zoo.ZOO_KEYS) | constructor, (algo, env_id)
+            kwargs = eval(block["policy_kwargs"], {"nn": nn})  # as the zoo evaluates it
+            assert isinstance(kwargs["net_arch"], list | dict)
+    ppo = yaml.safe_load((folder / "ppo.yml").read_text())
+    assert "motiongym/Sweeper-v0" not in ppo  # its native vec env and extractor are ours
+    assert "motiongym/Sweeper-v0: vec_env native" in (folder / "ppo.yml").read_text()
+    assert ppo["motiongym/HarvestArm-v0"]["policy_kwargs"] == "dict(net_arch=[256, 256])"
+
+
+def test_zoo_blocks_convert_our_names():
+    from motiongym.agents.zoo import refusal, zoo_block
+
+    block, options = zoo_block(
+        {"policy_kwargs": {"activation_fn": "tanh"}, "replay_buffer_class": "her",
+         "env_kwargs": {"distance": 1.0}, "eval_freq": 500, "deterministic": True}
+    )  # fmt: skip
+    assert block == {
+        "policy_kwargs": "dict(activation_fn=nn.Tanh)",
+        "replay_buffer_class": "HerReplayBuffer",
+    }
+    assert options == ["--env-kwargs distance:1.0", "--eval-freq 500"]
+    assert refusal({"vec_env": "pettingzoo"}) and refusal({"residual": "dig-cycle"})
+    assert refusal({"deterministic": False}) and refusal({}) is None
