@@ -41,9 +41,17 @@ docs: $(STAMP)
 	MUJOCO_GL=egl $(BIN)/sphinx-build -W --keep-going -q -b html docs/site docs/site/_build/html
 	@echo "docs/site/_build/html/index.html"
 
+# The type check (mypy, [tool.mypy] in pyproject.toml) of envs/ and baselines/ reads the
+# package through links in build/typecheck: setup.py maps the folders to the import name
+# motiongym, which mypy cannot follow.
+TYPED := build/typecheck/motiongym
 lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+	rm -rf $(TYPED) && mkdir -p $(TYPED)
+	for f in __init__.py systems.py py.typed; do ln -s $(CURDIR)/src/motiongym/$$f $(TYPED)/$$f; done
+	for d in envs baselines agents configs; do ln -s $(CURDIR)/$$d $(TYPED)/$$d; done
+	$(BIN)/mypy -p motiongym.envs -p motiongym.baselines
 
 # The shipped models (agents/pretrained/): every ID's configs/<ID>.yml first block
 # and the dual-arm shared-parameter block, three training seeds each; `ship`

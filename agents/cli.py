@@ -280,8 +280,8 @@ def _trust_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--trust",
         action="store_true",
-        help="load a model folder without manifest.json (nothing in it is unpickled either way; "
-        "default: refuse such a folder)",
+        help="load a model folder without manifest.json (nothing in it is ever unpickled; "
+        "default: refuse it)",
     )
 
 

@@ -12,7 +12,15 @@ episode_start, deterministic)``: a scripted policy from
   ``motiongym train`` (holding ``model.zip`` and, if the run normalised
   observations, ``vecnormalize.npz``, which is applied here). Nothing in a
   model folder is unpickled (:mod:`motiongym.agents.model_files`); a folder's
-  ``manifest.json`` is verified first, and one without needs ``trust``. A run whose
+  ``manifest.json`` is verified first, and one without needs ``trust``.
+  An rl-zoo3 run (``logs/<algo>/<env-name>_<n>/``, ``<env-name>`` the ID
+  with ``/`` as ``-``) keeps its model in ``<env-name>.zip`` and its
+  normalisation in ``<env-name>/vecnormalize.pkl``, a pickle: it is found,
+  named and refused (a pickle runs code when loaded; motiongym never unpickles
+  a file from a folder it is handed), with the two lines that convert it to
+  ``vecnormalize.npz`` beside the model where the user trusts the file,
+  which is then applied; a model from outside motiongym with no normalisation found is
+  evaluated on raw observations, with a warning that says so. A run whose
   ``config.yml`` says ``vec_env: pettingzoo`` trained one policy for every
   agent; it acts in the single-agent environment through
   :class:`~motiongym.agents.multiagent.SharedPolicyPredictor`. A run whose
@@ -139,11 +147,30 @@ class SampledModel:
 
 
 def model_path(path: Path) -> Path:
-    """The model file of a path that is a ``.zip`` or a run folder."""
+    """The model file of a path that is a ``.zip``, a run folder, or an rl-zoo3 run
+    folder (its final model ``<env-name>.zip``, beside its ``<env-name>/`` folder)."""
     candidate = path / MODEL_FILE if path.is_dir() else path
+    if path.is_dir() and not candidate.is_file():
+        zoo = [z for z in sorted(path.glob("*.zip")) if z.with_suffix("").is_dir()]
+        candidate = zoo[0] if len(zoo) == 1 else candidate
     if not candidate.is_file():
         raise UsageError(f"no model file at {candidate}")
     return candidate
+
+
+def zoo_normalization(file: Path, env_id: str) -> None:
+    """Refuse an rl-zoo3 run whose ``<env-name>/vecnormalize.pkl`` is not yet converted to
+    ``vecnormalize.npz`` beside the model ``file`` (named, with the conversion)."""
+    pickled = file.parent / env_id.replace("/", "-") / PICKLED_NORMALIZATION
+    if not pickled.is_file() or (file.parent / NORMALIZATION_FILE).is_file():
+        return
+    raise UsageError(
+        f"found the rl-zoo3 run's observation normalisation {pickled}: a pickle, which can "
+        "run any code when loaded, so motiongym never loads it; where you trust the file, "
+        "convert it to plain arrays: from motiongym.agents.model_files import "
+        "save_normalization; save_normalization(VecNormalize.load(PKL, DummyVecEnv([lambda: "
+        f"gym.make(ID)])), Path('{file.parent / NORMALIZATION_FILE}'))"
+    )
 
 
 def _normalized(model: BaseAlgorithm, file: Path, venv: VecEnv) -> Any:
@@ -228,6 +255,7 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
     ``deterministic: false`` through :class:`SampledModel`.
     """
     file = model_path(path)
+    zoo_normalization(file, env_id)
     check_provenance(file, trust)
     config = run_config(file)
     kwargs = _run_policy_kwargs(config)
@@ -243,6 +271,13 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
         predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
         if isinstance(model, MaskablePPO):
             predictor = MaskedModel(predictor, env)
+    beside = (file.parent / NORMALIZATION_FILE, file.parent / PICKLED_NORMALIZATION)
+    if not config and not any(f.is_file() for f in beside):
+        warn(
+            f"no observation normalisation found for {file} ({NORMALIZATION_FILE} beside it, "
+            f"or rl-zoo3's {env_id.replace('/', '-')}/{PICKLED_NORMALIZATION}): "
+            "evaluating it on raw observations"
+        )
     if not config.get("deterministic", True):
         predictor = SampledModel(predictor)
     if config.get("residual"):  # the model learned a correction of a scripted policy

@@ -21,10 +21,12 @@ call: pass ``episode_start=True`` on an episode's first step or call
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from gymnasium import spaces
+
+Shape = tuple[int, ...]  # a space's shape (None only for spaces without one)
 
 
 class ScriptedPolicy(ABC):
@@ -140,8 +142,8 @@ class ScriptedPolicy(ABC):
         space = self.observation_space
         if isinstance(space, spaces.Dict):
             key = next(iter(space.spaces))
-            return np.ndim(observation[key]) > len(space.spaces[key].shape)
-        return np.ndim(observation) > len(space.shape)
+            return np.ndim(observation[key]) > len(cast(Shape, space.spaces[key].shape))
+        return np.ndim(observation) > len(cast(Shape, space.shape))
 
 
 class _EntryCheck:

@@ -100,7 +100,8 @@ class Renders(OwnsRenderer):
     def _frame(self) -> np.ndarray:
         raise NotImplementedError
 
-    def render(self) -> np.ndarray | None:
+    # Any: gym.Env types it with its RenderFrame type variable; this returns an RGB array.
+    def render(self) -> Any:  # np.ndarray (rgb_array) or None
         if hasattr(self, "_require_reset"):
             self._require_reset("render")
         if self.render_mode is None:

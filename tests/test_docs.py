@@ -30,3 +30,24 @@ def test_docs_build_without_warnings_with_a_page_per_id(tmp_path):
     sweeper = (out / "environments" / "Sweeper-v0.html").read_text()
     assert "every reachable free cell" in sweeper and "Sweeper-v0_psa-cwa_seed1.gif" in sweeper
     assert "Park" in (out / "papers.html").read_text()
+    from motiongym.systems import declared
+
+    names = {name for policies in declared("baselines", "POLICIES").values() for name in policies}
+    assert sorted(p.stem for p in (out / "policies").glob("*.html")) == sorted([*names, "index"])
+    field = _text(out / "policies" / "potential-field.html")
+    # the paper, the policy module's docstring and the algorithm modules' equations
+    assert "Ryu" in field and "eq. 7" in field and "theta_dot = J* X_dot" in field
+    tutorials = sorted(p.stem for p in (out / "tutorials").glob("*.html"))
+    scripts = sorted(p.stem for p in (ROOT / "docs" / "tutorials").glob("*.py"))
+    assert tutorials == sorted([*scripts, "index"]) and len(scripts) == 3
+    assert "class FixedDelayPolicy(ScriptedPolicy)" in _text(
+        out / "tutorials" / "scripted_policy.html"
+    )
+
+
+def _text(page: Path) -> str:
+    """A page's text without its markup (highlighted code is split into spans)."""
+    import html
+    import re
+
+    return html.unescape(re.sub(r"<[^>]+>", "", page.read_text()))

@@ -223,7 +223,7 @@ def lane_open(occ_fp_next: np.ndarray, swept_edge: np.ndarray) -> bool:
     return not (occ_fp_next == 1).any() and not swept_edge.all()
 
 
-def stretches(todo: np.ndarray, cfg: tuple[int, int]) -> tuple[int, int, int, int]:
+def stretches(todo: np.ndarray, cfg: tuple[int, int]) -> tuple[int, ...]:  # 4 values
     """Per heading (E, N, W, S): how many ``todo`` configurations follow ``cfg`` in a row."""
     h, wd = todo.shape
     out = []

@@ -168,9 +168,9 @@ class DualArmCellEnv(NeedsReset, Renders, gym.Env):
         self.clearance_distance = p.clearance_distance
         self.weights = {name: getattr(p, name) for name in WEIGHTS}
         n_act = 2 if control == "both" else 1
-        self.action_space = spaces.Box(0.0, 1.0, (n_act,), np.float32)
+        self.action_space: spaces.Box = spaces.Box(0.0, 1.0, (n_act,), np.float32)
         lo, hi = observation_bounds()
-        self.observation_space = spaces.Box(lo, hi, dtype=np.float32)
+        self.observation_space: spaces.Box = spaces.Box(lo, hi, dtype=np.float32)
         self.world = DualArmWorld()
 
     # ------------------------------------------------------------------ API

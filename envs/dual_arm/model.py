@@ -179,9 +179,8 @@ def segments_collide(
     if len(near[0]) == 0:
         return out
     lead_idx, i, j = near[:-2], near[-2], near[-1]
-    dist, _, _ = closest_points_between_segments(
-        a1[(*lead_idx, i)], b1[(*lead_idx, i)], a2[(*lead_idx, j)], b2[(*lead_idx, j)]
-    )
+    at_i, at_j = (*lead_idx, i), (*lead_idx, j)
+    dist, _, _ = closest_points_between_segments(a1[at_i], b1[at_i], a2[at_j], b2[at_j])
     hit = dist - RADII[i] - RADII[j] <= margin
     if lead:
         out[tuple(idx[hit] for idx in lead_idx)] = True

@@ -48,7 +48,7 @@ class DualArmParallelEnv(ParallelEnv):
         self._steps = 0
         self._action_space = spaces.Box(0.0, 1.0, (1,), np.float32)
 
-    def observation_space(self, agent: str) -> spaces.Box:
+    def observation_space(self, agent: str) -> spaces.Space:
         return self._env.observation_space
 
     def action_space(self, agent: str) -> spaces.Box:
@@ -98,7 +98,7 @@ class DualArmParallelEnv(ParallelEnv):
         self._env.close()
 
     @property
-    def state_space(self) -> spaces.Box:
+    def state_space(self) -> spaces.Space:
         """The global state: the single-agent environment's observation (both arms)."""
         return self._env.observation_space
 

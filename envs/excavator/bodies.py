@@ -56,7 +56,7 @@ PART_NAMES = ("boom", "stick", "bucket", "house", "tracks")
 SELF_PAIRS = (("bucket", "tracks"), ("bucket", "house"), ("stick", "tracks"), ("stick", "house"))
 
 SKIP = 1e-9  # m: a lower bound this far above the distance of interest rules a body out
-Vec = tuple[float, float, float]
+Vec = tuple[float, ...]  # x, y, z
 
 
 @dataclass(frozen=True)
@@ -276,7 +276,7 @@ def machine_bodies(
     foot, stick_pin, pin, tip = points
     rot = _apply(rotation)
     axis, up = swing_axis(rotation, L0)
-    out = {}
+    out: dict[str, Capsule | Box] = {}
     for name in names or PART_NAMES:
         if name == "boom":
             out[name] = Capsule(foot, stick_pin, BOOM_RADIUS)

@@ -73,7 +73,7 @@ class ExcavatorBase(NeedsReset, Renders, gym.Env):
     """Shared wiring; see :class:`ExcavatorReachEnv` and :class:`ExcavatorEnv`."""
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
-    TASK: type = ReachTask
+    TASK: Any = ReachTask  # a task class of task.py (NAME, CARVE, REWARD_TERMS, ...)
 
     def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
         self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
@@ -85,8 +85,8 @@ class ExcavatorBase(NeedsReset, Renders, gym.Env):
         self.layout = obs_layout.observation_layout(self.TASK.NAME, p.physics)
         assert self.layout["q"].start == 0 and self.layout["fill"].stop == 13
         low, high = obs_layout.bounds(self.TASK.NAME, self.m, p.physics)
-        self.observation_space = spaces.Box(low, high, dtype=np.float32)
-        self.action_space = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
+        self.observation_space: spaces.Box = spaces.Box(low, high, dtype=np.float32)
+        self.action_space: spaces.Box = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
         self.world = self._make_world()
         self.task = self.TASK(p, self.layout)
         self._profile = self.layout["profile"]

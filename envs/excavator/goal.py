@@ -10,16 +10,16 @@ contact with the pipe or the truck (physics v1: or the machine itself).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 from motiongym.envs.excavator.observation import layout
-from motiongym.envs.excavator.params import params_for
+from motiongym.envs.excavator.params import ReachParams, params_for
 from motiongym.envs.goal import GoalFields
 
 
 def goal_fields(kwargs: dict[str, Any]) -> GoalFields:
     """The :class:`GoalFields` of the reach task that ``kwargs`` (the env's keywords) build."""
-    p = params_for("reach", kwargs)
+    p = cast(ReachParams, params_for("reach", kwargs))
     s = layout("reach", p.physics)
     assert s["tip"].stop == s["bucket"].start  # the achieved goal is one slice
     contacts = ("pipe_contact", "truck_contact")

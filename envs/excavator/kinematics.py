@@ -54,7 +54,7 @@ def base_rotation(phi: float, theta: float, psi: float) -> np.ndarray:
 
 def base_pose(
     position: tuple[float, float, float] = (0.0, 0.0, 0.0),
-    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    rpy: tuple[float, ...] = (0.0, 0.0, 0.0),  # roll, pitch, yaw
 ) -> np.ndarray:
     """``H_M^O`` (eq. 1): base frame in the reference frame, shape (4, 4)."""
     h = np.eye(4)

@@ -110,7 +110,7 @@ def pipe_clearance(
     bound up, and the visit stops at a bound not below the smallest clearance
     so far, which leaves the minimum unchanged.
     """
-    order = range(len(radii))
+    order: Sequence[int] = range(len(radii))
     if lower_bounds is not None:
         order = sorted(order, key=lower_bounds.__getitem__)
     out = math.inf

@@ -27,7 +27,7 @@ reward weights      finite, in [-1e6, 1e6]
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, ClassVar
 
 from motiongym.envs.core import (
     ArgumentError,
@@ -52,7 +52,7 @@ class ExcavatorParams:
     slope: float = 0.0  # rad
     render_size: tuple[int, int] = (480, 640)
 
-    REWARD_TERMS = ()
+    REWARD_TERMS: ClassVar[tuple[str, ...]] = ()
 
     def __post_init__(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731

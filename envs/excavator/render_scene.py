@@ -122,7 +122,7 @@ class SceneRenderer:
         self.camera = mujoco.MjvCamera()
         self.camera.lookat[:] = [3.0, 0.0, 0.5]
         self.camera.distance, self.camera.elevation, self.camera.azimuth = 24.0, -28.0, -130.0
-        self._terrain_key = None
+        self._terrain_key: tuple[int, int] | None = None
         self._hfield = self.model.hfield("ground").id
         self._swing_pos = self.model.body("swing").pos.copy()
 

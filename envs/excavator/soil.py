@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -119,8 +120,8 @@ class Terrain:
 
     def carve(
         self,
-        edge0: tuple[np.ndarray, np.ndarray],
-        edge1: tuple[np.ndarray, np.ndarray],
+        edge0: tuple[Sequence[float], Sequence[float]],
+        edge1: tuple[Sequence[float], Sequence[float]],
         z0: float,
         z1: float,
         free_capacity: float,
@@ -171,8 +172,8 @@ class Terrain:
 
     def _swept_cells(
         self,
-        edge0: tuple[np.ndarray, np.ndarray],
-        edge1: tuple[np.ndarray, np.ndarray],
+        edge0: tuple[Sequence[float], Sequence[float]],
+        edge1: tuple[Sequence[float], Sequence[float]],
         z0: float,
         z1: float,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int, int, int]] | None:

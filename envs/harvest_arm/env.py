@@ -178,8 +178,8 @@ class HarvestArmEnv(NeedsReset, Renders, gym.Env):
         self._limits = self.spec_arm.limits
         self._step_size = self.spec_arm.speeds * p.dt  # rad per unit action
         low, high = self.layout.bounds(self.spec_arm.speeds)
-        self.observation_space = spaces.Box(low, high, dtype=np.float32)
-        self.action_space = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
+        self.observation_space: spaces.Box = spaces.Box(low, high, dtype=np.float32)
+        self.action_space: spaces.Box = spaces.Box(-1.0, 1.0, (n,), dtype=np.float32)
         self._obs = np.zeros(self.layout.size, dtype=np.float32)
         s = self.layout.slices
         self._s_sin, self._s_cos, self._s_qdot = s["sin_q"], s["cos_q"], s["qdot"]

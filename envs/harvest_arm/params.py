@@ -39,10 +39,11 @@ class HarvestArmParams:
     ``width`` and ``height`` integers in [16, 4096].
     """
 
-    dof: int | None = None
+    # None given: the variant's default (ints after __post_init__)
+    dof: int = None  # type: ignore[assignment]
     planar: bool = False
-    n_obstacles: int | None = None
-    n_bars: int | None = None
+    n_obstacles: int = None  # type: ignore[assignment]
+    n_bars: int = None  # type: ignore[assignment]
     link_radius: float = 0.02  # m
     dt: float = 0.05  # s, control period
     safety_distance: float = 0.03  # m, the paper's collision-risk distance

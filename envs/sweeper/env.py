@@ -198,7 +198,7 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
         side = float(maps.MAX_SIDE)
         window = spaces.Box(0.0, 1.0, (S * S,), np.float32)
         coarse_map = spaces.Box(0.0, 1.0, (K * K,), np.float32)
-        keys = {
+        keys: dict[str, spaces.Space] = {
             "sensed": window,
             "swept": window,
             "pose": spaces.Box(

@@ -18,6 +18,7 @@ maze       48 x 48 a 5 x 5 maze, corridors 7 cells, walls 2 (Fig. 12)
 
 from __future__ import annotations
 
+import os
 import pathlib
 
 import numpy as np
@@ -73,7 +74,7 @@ def to_text(grid: np.ndarray) -> str:
     return "\n".join("".join("#" if v else "." for v in row) for row in grid) + "\n"
 
 
-def load_map_file(path: str | pathlib.Path, w: int = 1) -> np.ndarray:
+def load_map_file(path: str | os.PathLike, w: int = 1) -> np.ndarray:
     """Load a user map from a ``.txt`` or ``.png`` file and validate it for robot width ``w``."""
     path = pathlib.Path(path)
     if not path.is_file():

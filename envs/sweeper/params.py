@@ -72,7 +72,8 @@ class SweeperParams:
     map_file: str | os.PathLike | None = None
     grid: Any = None
     robot_width: int = 3  # cells
-    sensor_range: int | None = None  # cells beyond the footprint (None: robot_width)
+    # cells beyond the footprint; None given: robot_width (an int after __post_init__)
+    sensor_range: int = None  # type: ignore[assignment]
     coarse: int = 16  # built-map resolution in the observation
     heading_noise: float = 0.0  # rad, std per action
     slip_noise: float = 0.0  # relative std of a forward move's length

@@ -55,7 +55,8 @@ class World:
             (np.array([last]), full),
         ]
         self._rays = sight.ray_matrix(w, self.R) if params.line_of_sight else None
-        self.state: SweeperState | None = None
+        # None until reset() (the environment refuses a step or render before it)
+        self.state: SweeperState = None  # type: ignore[assignment]
 
     # ------------------------------------------------------------------ reset
     def reset(self, scenario: Scenario) -> SweeperState:
