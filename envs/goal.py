@@ -198,6 +198,7 @@ class GoalConditionedEnv(gym.Env):
         self.base_id, base_kwargs, self.fields = resolve({"base": base, "fields": fields, **kw})
         self.base = load_env_creator(gym.spec(base).entry_point)(**base_kwargs)
         self.metadata = self.base.metadata
+        self.dt = getattr(self.base, "dt", None)  # s, the base's control period
         self.render_mode = self.base.render_mode
         self.action_space = self.base.action_space
         box, f = self.base.observation_space, self.fields

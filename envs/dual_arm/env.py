@@ -117,6 +117,7 @@ class DualArmCellEnv(NeedsReset, Renders, gym.Env):
     * v0: first version (collision checked at the control samples only).
     """
 
+    dt = DT  # s, the control period (the paper's 20 ms sample time)
     metadata = {
         "render_modes": ["rgb_array", "human"],
         "render_fps": int(1 / DT),
