@@ -131,6 +131,7 @@ class ScriptedPolicy(ABC):
         """One :class:`_EntryCheck` per entry of the space (key None for a single space),
         built once: predict pays only the comparisons."""
         space = self.observation_space
+        checks: dict[Any, _EntryCheck]
         if isinstance(space, spaces.Dict):
             checks = {k: _EntryCheck(f"observation[{k!r}]", sub) for k, sub in space.spaces.items()}
         else:
@@ -157,7 +158,7 @@ class _EntryCheck:
     def __init__(self, name: str, space: spaces.Space) -> None:
         self.name, self.shape = name, tuple(space.shape or ())
         self.box = isinstance(space, spaces.Box)
-        if self.box:
+        if isinstance(space, spaces.Box):
             low, high = space.low.astype(np.float64), space.high.astype(np.float64)
             scale = np.maximum(np.abs(low), np.abs(high))
             slack = 1e-6 * (1.0 + np.where(np.isfinite(scale), scale, 0.0))

@@ -65,7 +65,10 @@ class Localiser:
         self.w, self.R, self.S = w, R, w + 2 * R
         self.sh, self.ss, self.n = heading_noise, slip_noise, n
         self.rng = np.random.default_rng(seed)
-        self.y = self.x = self.e = None  # (n,) particle states
+        # (n,) particle states (row, column, heading error), set at the first observation
+        self.y: np.ndarray = np.zeros(0)
+        self.x: np.ndarray = np.zeros(0)
+        self.e: np.ndarray = np.zeros(0)
         self.wt = np.full(n, 1.0 / n)
         self.reckoned: tuple[int, int] | None = None  # the last dead-reckoned cell
         self.cell = (0, 0)
