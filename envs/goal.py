@@ -197,6 +197,7 @@ class GoalConditionedEnv(gym.Env):
         self.cost = check_float("cost", cost, 0.0, 1e6)
         self.base_id, base_kwargs, self.fields = resolve({"base": base, "fields": fields, **kw})
         self.base = load_env_creator(gym.spec(base).entry_point)(**base_kwargs)
+        self.base.spec = gym.spec(base)  # its window, where human, says which world
         self.metadata = self.base.metadata
         self.dt = getattr(self.base, "dt", None)  # s, the base's control period
         self.render_mode = self.base.render_mode

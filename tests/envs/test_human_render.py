@@ -50,11 +50,12 @@ def test_human_mode_shows_a_frame_after_reset_and_every_step(drawing_display, en
     for _ in range(2):
         env.step(env.action_space.sample())
     assert env.render() is None  # shown, not returned
-    window = env.unwrapped._window
+    world = getattr(env.unwrapped, "base", env.unwrapped)  # a goal env shows its base's
+    window = world._window
     assert window.shown == 4 and window.image.get_array().shape[2] == 3
-    assert window.title == env_id
+    assert window.title == getattr(env.unwrapped, "base_id", env_id)
     env.close()
-    assert env.unwrapped._window is None and window.figure is None
+    assert world._window is None and window.figure is None
 
 
 def test_pettingzoo_render_and_state_tests_pass(drawing_display):
