@@ -39,6 +39,12 @@ from __future__ import annotations
 import math
 
 from motiongym.envs.excavator import bodies
+from motiongym.envs.excavator.clearances_v1 import (
+    HOUSE_RADIUS,
+    SKIP,
+    UNDER_REACH,
+    ClearancesV1,
+)
 from motiongym.envs.excavator.digging import DEPTH_TOLERANCE, PUSH, cuts, stall_fraction
 from motiongym.envs.excavator.hydraulics import hydraulic_rates
 from motiongym.envs.excavator.kinematics import arm_points, base_rotation
@@ -51,18 +57,12 @@ from motiongym.envs.excavator.scenes import (
     ground_plane,
 )
 from motiongym.envs.excavator.soil import cutting_force
-from motiongym.envs.excavator.world import HORIZON, POUR_NZ, POUR_TIME, ExcavatorWorld
+from motiongym.envs.excavator.world import POUR_NZ, POUR_TIME, ExcavatorWorld
 
 BISECTIONS = 6
-SELF_HORIZON = 0.3  # m: self clearance exact below this
-UNDER_REACH = 1.3  # m: how far any body (bucket box: 1.12 m) reaches from the arm's polyline
-PARTS = ("boom", "stick", "bucket")  # the arm's links, in the order of its polyline
-HOUSE_RADIUS = 3.5  # m: house and tracks lie within this of the swing axis (3.13 m, 0.3 m tilt)
 # The bucket shell's underside in the bucket frame: (fraction of L4 along u, m behind the opening).
 SHELL = ((0.0, 0.75), (0.6, 0.9), (0.85, 0.55))
 SHELL_INSET = 0.1  # m: shell points this far inside the side plates (one cell of the map)
-REACH = (bodies.BOOM_RADIUS, bodies.STICK_RADIUS, UNDER_REACH)  # each part's from its segment
-SKIP = bodies.SKIP  # m: a bound this far above the smallest clearance so far leaves its part out
 
 
 class Pose:
@@ -165,7 +165,7 @@ class Pose:
         return out
 
 
-class ExcavatorWorldV1(ExcavatorWorld):
+class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     """See the module docstring."""
 
     def reset(self, scene, q0) -> None:
@@ -441,185 +441,6 @@ class ExcavatorWorldV1(ExcavatorWorld):
     def _spill_on_ground(self, x: float, y: float, amount: float) -> None:
         """Loose soil (m3) returns to the ground as bank volume, ``amount / swell``."""
         self._deposit(x, y, amount / self.m.swell)
-
-    def _clearances(self) -> None:
-        """Exact body distances below the horizons, lower bounds above.
-
-        Pipe and truck: exact below ``HORIZON`` (1 m; the house against the
-        truck below ``SELF_HORIZON``); self: exact below ``SELF_HORIZON``
-        (0.3 m). Each part's bound, cheapest first: its segment of the arm's
-        polyline (the bucket's body lies within ``UNDER_REACH`` of it, a
-        link's within its radius; house and tracks within ``HOUSE_RADIUS``
-        of the swing axis) against the obstacle's bounding circle in plan
-        and its top; the bucket's bounding sphere next; a body is built only
-        when its bound is under its horizon. A clearance is the smallest of
-        these values; a part whose bound (``SKIP`` above it to cover
-        rounding) is not below the smallest so far cannot change it and is
-        left out: the values are those of computing every part.
-        """
-        pts = self.points
-        z0, z1, z2, z3 = pts[0][2], pts[1][2], pts[2][2], pts[3][2]
-        lows = (z1 if z1 < z0 else z0, z2 if z2 < z1 else z1, z3 if z3 < z2 else z2)
-        cache: dict = {}
-        to_truck, to_axis = _plan_gaps(pts, self._truck_centre, self._axis)
-        self.pipe_clear = self._pipe_clearance(cache, lows)
-        self.truck_clear = self._truck_clearance(cache, lows, to_truck)
-        self.self_clear = self._self_clearance(cache, lows, to_axis)
-
-    def _pipe_clearance(self, cache: dict, lows) -> float:
-        top = self._pipe_top
-        d0, d1, d2 = lows[0] - REACH[0] - top, lows[1] - REACH[1] - top, lows[2] - REACH[2] - top
-        if d0 >= HORIZON and d1 >= HORIZON and d2 >= HORIZON:  # far: the bounds stand
-            return min(d0, d1, d2)
-        best = math.inf
-        for k, name in enumerate(PARTS):
-            d = lows[k] - REACH[k] - top
-            if d < HORIZON:
-                if d - best >= SKIP:
-                    continue
-                d = self._exact(cache, name, self._pipe_body, self._pipe_gap, HORIZON, best)
-            if d < best:
-                best = d
-        return best
-
-    def _truck_clearance(self, cache: dict, lows, plan) -> float:
-        box, best = self._truck_body, self._house_truck
-        if best < SELF_HORIZON:
-            best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
-        radius, height = self._truck_radius, self.truck.height
-        for k, name in enumerate(PARTS):
-            gap, above = plan[k] - radius, lows[k] - height
-            d = (above if above > gap else gap) - REACH[k]
-            if d < HORIZON:
-                if d - best >= SKIP:
-                    continue
-                d = self._exact(cache, name, box, box.gap, HORIZON, best)
-            if d < best:
-                best = d
-        return best
-
-    def _self_clearance(self, cache: dict, lows, plan) -> float:
-        best, top = math.inf, self._house_top
-        for k, name in ((2, "bucket"), (1, "stick")):  # the bucket's cheap bounds first
-            gap, above = plan[k - 1] - HOUSE_RADIUS, lows[k] - top
-            d = (above if above > gap else gap) - REACH[k]
-            if d >= SELF_HORIZON:
-                if d < best:
-                    best = d
-            elif d - best < SKIP:
-                for other in (self._tracks_box, self._part(cache, "house")):
-                    if k == 2:  # the bucket: its sphere's bound first
-                        c, r = self._sphere(cache, "bucket")
-                        d = other.gap(c) - r
-                        if d < SELF_HORIZON and d - self._bucket_slack - best < SKIP:
-                            d = self._box_distance(cache, "bucket", other, SELF_HORIZON, best)
-                    else:
-                        d = self._exact(cache, name, other, None, SELF_HORIZON, best)
-                    if d < best:
-                        best = d
-        return best
-
-    def _exact(self, cache: dict, name: str, other, gap, horizon: float, best=math.inf) -> float:
-        """Distance of part ``name`` to ``other``; for a box, its sphere's and its
-        separating axes' bounds first (the bound is returned when not under ``horizon``).
-
-        A bound ``SKIP`` or more above ``best`` is returned as it is (the
-        distance, not smaller, would not be the smallest either).
-        """
-        if name == "bucket" or name == "house":
-            c, r = self._sphere(cache, name)
-            d = (gap(c) if gap is not None else other.gap(c)) - r
-            if d >= horizon or d - self._sphere_slack[name] - best >= SKIP:
-                return d
-            return self._box_distance(cache, name, other, horizon, best)
-        if isinstance(other, bodies.Box):
-            k, pts = PARTS.index(name), self.points
-            return bodies.segment_to_box(pts[k], pts[k + 1], other, best + REACH[k]) - REACH[k]
-        return bodies.distance(self._part(cache, name), other)
-
-    def _box_distance(self, cache: dict, name: str, other, horizon: float, best: float) -> float:
-        """Distance of the bucket's or the house's box to ``other``: the separating axes'
-        bound when not under ``horizon`` (or ``SKIP`` above ``best``), else exact."""
-        body = self._part(cache, name)
-        d = bodies.lower_bound(body, other)
-        if d >= horizon or d - best >= SKIP:
-            return d
-        return bodies.distance(body, other)
-
-    def _part(self, cache: dict, name: str):
-        if name == "tracks":
-            return self._tracks_box
-        if name not in cache:
-            if name == "house":
-                pose = self._pose_now
-                cache[name] = bodies.house_box(
-                    self._swing_axis, self._up, pose.c1, pose.s1, self.rotation
-                )
-            else:
-                cache.update(self._bodies((name,)))
-        return cache[name]
-
-    def _pipe_gap(self, c) -> float:
-        """Distance from the point ``c`` to the pipe's surface (a lower bound's core)."""
-        (ax, ay, az), (dx, dy, dz), inv = self._pipe_line3
-        px, py, pz = c[0] - ax, c[1] - ay, c[2] - az
-        t = (px * dx + py * dy + pz * dz) * inv
-        t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-        x, y, z = px - t * dx, py - t * dy, pz - t * dz
-        return math.sqrt(x * x + y * y + z * z) - self.pipe.radius
-
-    def _bodies(self, names=None) -> dict:
-        return bodies.machine_bodies(
-            self.points, self.q[0], self.rotation, self.m.bucket_width, self.m.L0, names
-        )
-
-    def _sphere(self, cache: dict, name: str) -> tuple[tuple[float, float, float], float]:
-        """Bounding sphere ``(centre, radius)`` of the bucket's or the house's body."""
-        key = _SPHERE_KEYS[name]
-        if key in cache:
-            return cache[key]
-        if name == "bucket":
-            pin, pose = self.points[2], self._pose_now
-            along, back, radius = self._bucket_sphere
-            u, n = pose.u, pose.n
-            centre = (
-                pin[0] + along * u[0] - back * n[0],
-                pin[1] + along * u[1] - back * n[1],
-                pin[2] + along * u[2] - back * n[2],
-            )
-            cache[key] = centre, radius
-            return cache[key]
-        c1, s1 = self._pose_now.c1, self._pose_now.s1
-        x, y, z = self._house_mid
-        house = (-self.m.L0 + c1 * x - s1 * y, s1 * x + c1 * y, z)
-        if self.rotation:
-            (a, b, c), (d, e, f), (g, h, i) = self.rotation
-            x, y, z = house
-            house = (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-        cache[key] = house, self._house_radius
-        return cache[key]
-
-
-_SPHERE_KEYS = {"bucket": "bucket sphere", "house": "house sphere"}  # in a step's cache
-
-
-def _plan_gaps(pts, p, q) -> tuple[list[float], list[float]]:
-    """Plan-view distances from the point ``p`` to the arm's three segments (boom,
-    stick, bucket) and from ``q`` to the last two."""
-    to_p, to_q = [], []
-    pairs = ((p, to_p),)
-    (ax, ay, _), rest = pts[0], pts[1:]
-    for b in rest:
-        bx, by = b[0], b[1]
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        for (x, y), out in pairs:
-            px, py = x - ax, y - ay
-            t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
-            t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-            out.append(math.hypot(px - t * dx, py - t * dy))
-        pairs, ax, ay = ((p, to_p), (q, to_q)), bx, by
-    return to_p, to_q
 
 
 def _lerp(a, b, t: float) -> list[float]:

@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import motiongym  # noqa: E402,F401
-from motiongym.envs.excavator import bodies, world_v1  # noqa: E402
+from motiongym.envs.excavator import bodies, clearances_v1, world_v1  # noqa: E402
 from motiongym.envs.excavator.digging import DEPTH_TOLERANCE  # noqa: E402
 from motiongym.envs.excavator.obstacles import segment_box_distance  # noqa: E402
 from motiongym.envs.excavator.scenes import CELL_XS, CELL_YS, ground_plane  # noqa: E402
@@ -81,6 +81,7 @@ def _clearances(world):
 def _every_part(world, monkeypatch):
     """The clearances with nothing left out (``SKIP`` infinite)."""
     with monkeypatch.context() as patch:
+        patch.setattr(clearances_v1, "SKIP", math.inf)
         patch.setattr(world_v1, "SKIP", math.inf)
         patch.setattr(bodies, "SKIP", math.inf)
         world._clearances()
@@ -101,7 +102,7 @@ def test_clearances_are_those_of_every_part(env_id, monkeypatch):
             _, _, terminated, truncated, _ = env.step(env.action_space.sample())
             fast = _clearances(world)
             assert _every_part(world, monkeypatch) == fast
-            near += world.truck_clear < world_v1.HORIZON or world.self_clear < 0.3
+            near += world.truck_clear < clearances_v1.HORIZON or world.self_clear < 0.3
             if terminated or truncated:
                 env.reset()
     for q in np.random.default_rng(3).uniform(m.q_min, m.q_max, size=(500, 4)):
