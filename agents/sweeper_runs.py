@@ -40,7 +40,8 @@ MODE_GROUPS = {
 
 
 class _RunHook:
-    """Per-step hook: travel by mode, PSA's coverage at the hand-over, the last info."""
+    """Per-step hook: travel by mode, PSA's coverage at the hand-over (the coverage after
+    the last step PSA acted in; 0.0 if the policy never acted in PSA), the last info."""
 
     def __init__(self, max_steps: int | None) -> None:
         self.max_steps = max_steps

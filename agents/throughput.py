@@ -193,7 +193,9 @@ def bench(out_dir: Path, quick: bool = False, env_ids: list[str] | None = None) 
 
     rows = []
     for env_id in env_ids:
-        rates = interleaved_steps_per_second({env_id: make_env(env_id), **references}, seconds)
+        env = make_env(env_id)
+        rates = interleaved_steps_per_second({env_id: env, **references}, seconds)
+        dt = getattr(env.unwrapped, "dt", None)  # s, the control period; None: a grid world
         row: dict[str, Any] = {"id": env_id, "steps_per_s": rates[env_id]}
         for reference in REFERENCES:
             row[f"x {reference}"] = rates[env_id] / rates[reference]
@@ -205,7 +207,6 @@ def bench(out_dir: Path, quick: bool = False, env_ids: list[str] | None = None) 
             name: policy_ms_per_step(env_id, name, 200 if quick else 2000)
             for name in scripted_policies(env_id)
         }
-        dt = getattr(make_env(env_id).unwrapped, "dt", None)  # s; None: no clock (grid)
         row["control_period_ms"] = None if dt is None else 1000.0 * dt
         row["ppo_steps_per_s"] = ppo_steps_per_second(env_id, ppo_steps)
         row["x PPO Reacher-v5"] = row["ppo_steps_per_s"] / results["references"]["PPO Reacher-v5"]
