@@ -26,6 +26,7 @@ import hashlib
 import json
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import gymnasium as gym
@@ -46,48 +47,43 @@ STEPS = 400
 SEEDS = (3, 11)
 
 
-def _numbers(value, out: list[np.ndarray]) -> None:
-    """Every number in ``value`` (dicts in key order) appended to ``out`` as float64."""
+def _leaves(value) -> Iterator[bytes | np.ndarray]:
+    """What a step's part holds, in a fixed order: dict keys (sorted) and strings as bytes,
+    numbers as arrays; anything else (None, objects) carries no behaviour to pin."""
     if isinstance(value, dict):
         for key in sorted(value):
-            _numbers(value[key], out)
+            yield str(key).encode()
+            yield from _leaves(value[key])
+    elif isinstance(value, (str, bytes)):
+        yield value.encode() if isinstance(value, str) else value
     elif isinstance(value, (bool, int, float, np.number, np.bool_, np.ndarray, list, tuple)):
         a = np.asarray(value)
         if a.dtype == object:
             for v in value:
-                _numbers(v, out)
-        elif a.dtype.kind in "biuf":
-            out.append(a.astype(np.float64).ravel())
+                yield from _leaves(v)
+        else:
+            yield a
 
 
 def _fingerprint(fp: np.ndarray, t: int, parts: tuple) -> None:
     """Add step ``t``'s parts to ``fp`` (one row per part: count, sum, squares, t-weighted)."""
     for row, part in zip(fp, parts, strict=True):
-        out: list[np.ndarray] = []
-        _numbers(part, out)
-        x = np.concatenate(out) if out else np.zeros(0)
+        numbers = [
+            leaf.astype(np.float64).ravel()
+            for leaf in _leaves(part)
+            if isinstance(leaf, np.ndarray) and leaf.dtype.kind in "biuf"
+        ]
+        x = np.concatenate(numbers) if numbers else np.zeros(0)
         row += (x.size, x.sum(), (x * x).sum(), (t + 1) * x.sum())
 
 
 def _update(h, value) -> None:
-    if isinstance(value, dict):
-        for key in sorted(value):
-            h.update(str(key).encode())
-            _update(h, value[key])
-    elif isinstance(value, (str, bytes)):
-        h.update(value.encode() if isinstance(value, str) else value)
-    elif isinstance(value, (bool, int, float, np.number, np.bool_, np.ndarray, list, tuple)):
-        a = np.asarray(value)
-        if a.dtype == object:
-            for v in value:
-                _update(h, v)
+    for leaf in _leaves(value):
+        if isinstance(leaf, bytes):
+            h.update(leaf)
         else:
-            h.update(
-                np.ascontiguousarray(
-                    a, dtype=np.float64 if a.dtype.kind in "biuf" else a.dtype
-                ).tobytes()
-            )
-    # anything else (None, objects) carries no behaviour to pin
+            kind = np.float64 if leaf.dtype.kind in "biuf" else leaf.dtype
+            h.update(np.ascontiguousarray(leaf, dtype=kind).tobytes())
 
 
 def trajectory_hash(env_id: str, policy_name: str) -> tuple[str, list[list[float]]]:
@@ -145,6 +141,25 @@ def test_trajectory_unchanged(env_id, policy_name):
     expected = _recorded(FINGERPRINTS).get(key)
     assert expected is not None, f"{key}: hash differs and no fingerprint is recorded"
     np.testing.assert_allclose(fingerprint, expected, rtol=RTOL, atol=1e-12, err_msg=key)
+
+
+def test_fingerprint_tolerates_last_bits_not_a_change():
+    """The fallback's two sides: a last-bit difference (what BLAS kernels make) passes,
+    a change of behaviour of one part in a million fails."""
+    rng = np.random.default_rng(0)
+    steps = [(rng.normal(size=4), rng.normal(size=10), 1.0, False, False, {"d": 0.5})
+             for _ in range(50)]  # fmt: skip
+
+    def fingerprint(scale: float) -> np.ndarray:
+        fp = np.zeros((len(PARTS), 4))
+        for t, (a, o, r, te, tr, info) in enumerate(steps):
+            _fingerprint(fp, t, (a, o * (1 + scale * (t == 20)), r, te, tr, info))
+        return fp
+
+    base = fingerprint(0.0)
+    np.testing.assert_allclose(fingerprint(1e-15), base, rtol=RTOL, atol=1e-12)
+    with pytest.raises(AssertionError):
+        np.testing.assert_allclose(fingerprint(1e-6), base, rtol=RTOL, atol=1e-12)
 
 
 if __name__ == "__main__" and "--record" in sys.argv:
