@@ -51,18 +51,20 @@ class ClearancesV1:
         lows = (z1 if z1 < z0 else z0, z2 if z2 < z1 else z1, z3 if z3 < z2 else z2)
         cache: dict = {}
         to_truck, to_axis = _plan_gaps(pts, self._truck_centre, self._axis)
-        self.pipe_clear = self._pipe_clearance(cache, lows)
-        self.truck_clear = self._truck_clearance(cache, lows, to_truck)
-        self.self_clear = self._self_clearance(cache, lows, to_axis)
-
-    def _pipe_clearance(self, cache: dict, lows) -> float:
         top = self._pipe_top
         d0, d1, d2 = lows[0] - REACH[0] - top, lows[1] - REACH[1] - top, lows[2] - REACH[2] - top
         if d0 >= HORIZON and d1 >= HORIZON and d2 >= HORIZON:  # far: the bounds stand
-            return min(d0, d1, d2)
+            self.pipe_clear = d0 if d0 <= d1 and d0 <= d2 else d1 if d1 <= d2 else d2
+        else:
+            self.pipe_clear = self._pipe_clearance(cache, (d0, d1, d2))
+        self.truck_clear = self._truck_clearance(cache, lows, to_truck)
+        self.self_clear = self._self_clearance(cache, lows, to_axis)
+
+    def _pipe_clearance(self, cache: dict, bounds) -> float:
+        """The pipe clearance from the parts' bounds ``bounds`` (one under ``HORIZON``)."""
         best = math.inf
         for k, name in enumerate(PARTS):
-            d = lows[k] - REACH[k] - top
+            d = bounds[k]
             if d < HORIZON:
                 if d - best >= SKIP:
                     continue
@@ -88,24 +90,31 @@ class ClearancesV1:
         return best
 
     def _self_clearance(self, cache: dict, lows, plan) -> float:
-        best, top = math.inf, self._house_top
-        for k, name in ((2, "bucket"), (1, "stick")):  # the bucket's cheap bounds first
-            gap, above = plan[k - 1] - HOUSE_RADIUS, lows[k] - top
-            d = (above if above > gap else gap) - REACH[k]
-            if d >= SELF_HORIZON:
+        """Bucket, then stick, against tracks and house (the bucket's cheap bounds first)."""
+        best, top, horizon = math.inf, self._house_top, SELF_HORIZON
+        gap, above = plan[1] - HOUSE_RADIUS, lows[2] - top
+        d = (above if above > gap else gap) - UNDER_REACH
+        if d >= horizon:
+            best = d
+        else:  # the bucket: its sphere's bound first
+            (x, y, z), r = self._sphere(cache, "bucket")
+            slack = self._bucket_slack
+            for other in (self._tracks_box, self._part(cache, "house")):
+                d = other.gap((x, y, z)) - r
+                if d < horizon and d - slack - best < SKIP:
+                    d = self._box_distance(cache, "bucket", other, horizon, best)
                 if d < best:
                     best = d
-            elif d - best < SKIP:
-                for other in (self._tracks_box, self._part(cache, "house")):
-                    if k == 2:  # the bucket: its sphere's bound first
-                        c, r = self._sphere(cache, "bucket")
-                        d = other.gap(c) - r
-                        if d < SELF_HORIZON and d - self._bucket_slack - best < SKIP:
-                            d = self._box_distance(cache, "bucket", other, SELF_HORIZON, best)
-                    else:
-                        d = self._exact(cache, name, other, None, SELF_HORIZON, best)
-                    if d < best:
-                        best = d
+        gap, above = plan[0] - HOUSE_RADIUS, lows[1] - top
+        d = (above if above > gap else gap) - REACH[1]
+        if d >= horizon:
+            return d if d < best else best
+        if d - best < SKIP:  # the stick's capsule against each box
+            pts, reach = self.points, REACH[1]
+            for other in (self._tracks_box, self._part(cache, "house")):
+                d = bodies.segment_to_box(pts[1], pts[2], other, best + reach) - reach
+                if d < best:
+                    best = d
         return best
 
     def _exact(self, cache: dict, name: str, other, gap, horizon: float, best=math.inf) -> float:
@@ -192,20 +201,23 @@ class ClearancesV1:
 _SPHERE_KEYS = {"bucket": "bucket sphere", "house": "house sphere"}  # in a step's cache
 
 
-def _plan_gaps(pts, p, q) -> tuple[list[float], list[float]]:
+def _plan_gaps(pts, p, q) -> tuple[tuple[float, ...], tuple[float, float]]:
     """Plan-view distances from the point ``p`` to the arm's three segments (boom,
     stick, bucket) and from ``q`` to the last two."""
-    to_p, to_q = [], []
-    pairs = ((p, to_p),)
-    (ax, ay, _), rest = pts[0], pts[1:]
-    for b in rest:
-        bx, by = b[0], b[1]
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        for (x, y), out in pairs:
-            px, py = x - ax, y - ay
-            t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
-            t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-            out.append(math.hypot(px - t * dx, py - t * dy))
-        pairs, ax, ay = ((p, to_p), (q, to_q)), bx, by
-    return to_p, to_q
+    (x0, y0, _), (x1, y1, _), (x2, y2, _), (x3, y3, _) = pts
+    (px, py), (qx, qy) = p, q
+    boom = _plan_gap(px, py, x0, y0, x1 - x0, y1 - y0)
+    dx, dy = x2 - x1, y2 - y1
+    stick, stick_q = _plan_gap(px, py, x1, y1, dx, dy), _plan_gap(qx, qy, x1, y1, dx, dy)
+    dx, dy = x3 - x2, y3 - y2
+    bucket, bucket_q = _plan_gap(px, py, x2, y2, dx, dy), _plan_gap(qx, qy, x2, y2, dx, dy)
+    return (boom, stick, bucket), (stick_q, bucket_q)
+
+
+def _plan_gap(x: float, y: float, ax: float, ay: float, dx: float, dy: float) -> float:
+    """Plan-view distance from ``(x, y)`` to the segment from ``(ax, ay)`` along ``(dx, dy)``."""
+    px, py = x - ax, y - ay
+    length2 = dx * dx + dy * dy
+    t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0
+    t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+    return math.hypot(px - t * dx, py - t * dy)

@@ -37,6 +37,7 @@ stopped a part other than the cutting edge) is reported, not ended on.
 from __future__ import annotations
 
 import math
+from math import cos, sin
 
 from motiongym.envs.excavator import bodies
 from motiongym.envs.excavator.clearances_v1 import (
@@ -47,7 +48,7 @@ from motiongym.envs.excavator.clearances_v1 import (
 )
 from motiongym.envs.excavator.digging import DEPTH_TOLERANCE, PUSH, cuts, stall_fraction
 from motiongym.envs.excavator.hydraulics import hydraulic_rates
-from motiongym.envs.excavator.kinematics import arm_points, base_rotation
+from motiongym.envs.excavator.kinematics import base_rotation
 from motiongym.envs.excavator.scenes import (
     CELL_XS,
     CELL_YS,
@@ -93,37 +94,45 @@ class Pose:
         self.q, self._world = q, world
         # (terrain, its version, depth): the exact depths below, kept while the ground stays.
         self.edge_memo = self.body_memo = (None, -1, 0.0)
-        m, r = world.m, world.rotation
+        # arm_points (eq. 4, scalar form) written out with the same arithmetic; the
+        # bucket's angle beta = q2 + q3 + q4 is its last joint sum (cos, sin shared).
+        L0, L1, d1, d2, L2, L3, L4 = world._links
         q1, q2, q3, q4 = q
-        pts = arm_points(q1, q2, q3, q4, m)
-        self.c1, self.s1 = c1, s1 = math.cos(q1), math.sin(q1)
-        beta = q2 + q3 + q4
-        cb, sb = math.cos(beta), math.sin(beta)
+        self.c1, self.s1 = c1, s1 = cos(q1), sin(q1)
+        a3 = q2 + q3
+        beta = a3 + q4
+        cb, sb = cos(beta), sin(beta)
+        fx, fy = -L0 + c1 * L1 + s1 * d2, s1 * L1 - c1 * d2
+        r2, z2 = L2 * cos(q2), L2 * sin(q2)
+        r3, z3 = r2 + L3 * cos(a3), z2 + L3 * sin(a3)
+        r4, z4 = r3 + L4 * cb, z3 + L4 * sb
+        p1 = (fx + c1 * r2, fy + s1 * r2, d1 + z2)
+        p2 = (fx + c1 * r3, fy + s1 * r3, d1 + z3)
+        tip = (fx + c1 * r4, fy + s1 * r4, d1 + z4)
+        foot = (fx, fy, d1)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
-        if r is not None:  # R v for each point and axis
-            (a, b, c), (d, e, f), (g, h, i) = r
-            pts = tuple(
-                [
-                    (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-                    for x, y, z in pts
-                ]
+        if world.rotation is not None:  # R v for each point and axis
+            rot = world._turn
+            foot, p1, p2, tip, n, u, lat = (
+                rot(foot),
+                rot(p1),
+                rot(p2),
+                rot(tip),
+                rot(n),
+                rot(u),
+                rot(lat),
             )
-            (x, y, z), (x1, y1, z1) = n, u
-            n = (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-            u = (a * x1 + b * y1 + c * z1, d * x1 + e * y1 + f * z1, g * x1 + h * y1 + i * z1)
-            x, y = s1, -c1
-            lat = (a * x + b * y + c * 0.0, d * x + e * y + f * 0.0, g * x + h * y + i * 0.0)
-        self.points, self.tip, self.beta = pts, pts[3], beta
+        self.points, self.tip, self.beta = (foot, p1, p2, tip), tip, beta
         self.n, self.u, self.lat = n, u, lat
-        tip, half = pts[3], world._edge_half
+        half = world._edge_half
         lx, ly, lz = half * lat[0], half * lat[1], half * lat[2]
         # Heights above the ground plane: of the lowest arm point past the foot, and the edge.
         gx, gy = world._gx, world._gy
-        _, (x1, y1, z1), (x2, y2, z2), (x3, y3, z3) = pts
+        (x1, y1, z1), (x2, y2, z2), (x3, y3, z3) = p1, p2, tip
         h1, h2, h3 = z1 - gx * x1 - gy * y1, z2 - gx * x2 - gy * y2, z3 - gx * x3 - gy * y3
         low = h2 if h2 < h1 else h1
         self.low_arm = h3 if h3 < low else low
-        self.low_edge = tip[2] - gx * tip[0] - gy * tip[1] - abs(lz) - abs(gx * lx + gy * ly)
+        self.low_edge = h3 - abs(lz) - abs(gx * lx + gy * ly)
 
     def edge(self) -> tuple[tuple[float, float, float], ...]:
         """The cutting edge's two ends and its middle (the tip), O."""
@@ -171,6 +180,9 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def reset(self, scene, q0) -> None:
         base = tuple(scene.base)
         self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
+        self._turn = _rotator(self.rotation)
+        m = self.m
+        self._links = (m.L0, m.L1, m.d1, m.d2, m.L2, m.L3, m.L4)
         self.self_clear = math.inf
         self.ground_contact = 0.0
         self.cut_force = 0.0
@@ -336,9 +348,7 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     # --------------------------------------------------------------- physics
     def _rot(self, v) -> tuple[float, float, float]:
         """``R v``: a vector of frame M in frame O (the base rotation)."""
-        (a, b, c), (d, e, f), (g, h, i) = self.rotation
-        x, y, z = v
-        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+        return self._turn(v)
 
     def _pose(self, q) -> Pose:
         return Pose(q, self)
@@ -441,6 +451,19 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def _spill_on_ground(self, x: float, y: float, amount: float) -> None:
         """Loose soil (m3) returns to the ground as bank volume, ``amount / swell``."""
         self._deposit(x, y, amount / self.m.swell)
+
+
+def _rotator(rotation):
+    """``v -> R v`` for the rows of ``rotation`` (None: level, no rotation is applied)."""
+    if rotation is None:
+        return None
+    (a, b, c), (d, e, f), (g, h, i) = rotation
+
+    def turn(v) -> tuple[float, float, float]:
+        x, y, z = v
+        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+
+    return turn
 
 
 def _lerp(a, b, t: float) -> list[float]:
