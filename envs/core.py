@@ -212,11 +212,24 @@ def reward_and_info(
     ``info`` holds ``is_success``, ``cost``, the ``measures`` and
     ``reward_<term>`` for every term.
     """
-    reward = sum(terms.values())
     info: dict[str, Any] = {"is_success": bool(is_success), "cost": float(cost), **measures}
+    return add_reward_terms(info, terms), info
+
+
+_REWARD_KEYS: dict[str, str] = {}  # term -> "reward_<term>", made once per name
+
+
+def add_reward_terms(info: dict[str, Any], terms: Mapping[str, float]) -> float:
+    """Write ``reward_<term>`` for every term into ``info``; return the reward (their
+    sum, in their order). For a step that builds its ``info`` itself, in the layout of
+    :func:`reward_and_info`."""
+    keys = _REWARD_KEYS
     for key, value in terms.items():
-        info[f"reward_{key}"] = float(value)
-    return float(reward), info
+        name = keys.get(key)
+        if name is None:
+            name = keys[key] = f"reward_{key}"
+        info[name] = float(value)
+    return float(sum(terms.values()))
 
 
 def zero_terms(names: Iterable[str]) -> dict[str, float]:

@@ -77,7 +77,7 @@ class ClearancesV1:
         box, best = self._truck_body, self._house_truck
         if best < SELF_HORIZON:
             best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
-        radius, height = self._truck_radius, self.truck.height
+        radius, height = self._truck_radius, self._truck_height
         for k, name in enumerate(PARTS):
             gap, above = plan[k] - radius, lows[k] - height
             d = (above if above > gap else gap) - REACH[k]

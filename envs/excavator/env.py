@@ -21,10 +21,10 @@ from motiongym.envs.actions import checked_box_action
 from motiongym.envs.core import (
     ArgumentError,
     NeedsReset,
+    add_reward_terms,
     check_options,
     check_render_mode,
     check_shape,
-    reward_and_info,
     zero_terms,
 )
 from motiongym.envs.excavator import observation as obs_layout
@@ -144,23 +144,24 @@ class ExcavatorBase(NeedsReset, Renders, gym.Env):
         return buf.copy()
 
     def _reward_and_info(self, terms: dict[str, float], success: bool):
+        """The reward and ``info`` in the layout of :func:`reward_and_info`, built in one go."""
         w = self.world
-        cost = w.pipe_clear < self.params.pipe_safety or w.contact
-        return reward_and_info(
-            terms,
-            cost=1.0 if cost else 0.0,
-            is_success=success,
-            pipe_clearance=float(w.pipe_clear),
-            truck_clearance=float(w.truck_clear),
-            pipe_contact=1.0 if w.pipe_clear <= 0.0 else 0.0,
-            truck_contact=1.0 if w.truck_clear <= 0.0 else 0.0,
-            bucket_fill=float(w.fill),
-            truck_soil=float(w.truck_soil),
-            spill=float(w.spill),
-            elapsed=float(w.elapsed),
-            **w.measures(),
-            **self.task.measures(w),
-        )
+        pipe, truck = w.pipe_clear, w.truck_clear
+        info: dict[str, Any] = {
+            "is_success": bool(success),
+            "cost": 1.0 if pipe < self.params.pipe_safety or w.contact else 0.0,
+            "pipe_clearance": float(pipe),
+            "truck_clearance": float(truck),
+            "pipe_contact": 1.0 if pipe <= 0.0 else 0.0,
+            "truck_contact": 1.0 if truck <= 0.0 else 0.0,
+            "bucket_fill": float(w.fill),
+            "truck_soil": float(w.truck_soil),
+            "spill": float(w.spill),
+            "elapsed": float(w.elapsed),
+        }
+        info.update(w.measures())
+        info.update(self.task.measures(w))
+        return add_reward_terms(info, terms), info
 
     def _frame(self) -> np.ndarray:
         if self._renderer is None:

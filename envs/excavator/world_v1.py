@@ -195,8 +195,11 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def _obstacle_bounds(self, scene) -> None:
         """The pipe's and the truck's bodies and the constants of their bounds."""
         pipe, truck = scene.pipe, scene.truck
-        self._pipe_body = bodies.Capsule(pipe.a, pipe.b, pipe.radius)
-        self._pipe_top = max(pipe.a[2], pipe.b[2]) + pipe.radius
+        # Every constant a step reads is a Python float (a scene's NumPy scalars hold the
+        # same doubles, at several times the cost per operation).
+        self._pipe_body = _floats(bodies.Capsule(pipe.a, pipe.b, pipe.radius))
+        self._pipe_top = float(max(pipe.a[2], pipe.b[2]) + pipe.radius)
+        self._truck_height = float(truck.height)
         self._truck_centre = (truck.cx, truck.cy)
         self._truck_radius = math.hypot(truck.half_length, truck.half_width)
         self._axis = (-self.m.L0, 0.0)
@@ -208,28 +211,30 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         )
         self._house_top = bodies.HOUSE[2][1] + 0.35  # + the tilt's lift at 3.5 m
         d = tuple(b - a for a, b in zip(pipe.a, pipe.b, strict=True))
-        self._pipe_line3 = (pipe.a, d, 1.0 / max(sum(x * x for x in d), 1e-12))
+        self._pipe_line3 = _floats((pipe.a, d, 1.0 / max(sum(x * x for x in d), 1e-12)))
         c, s = math.cos(truck.yaw), math.sin(truck.yaw)
-        self._truck_body = bodies.box_from_ranges(
-            (truck.cx, truck.cy, 0.0),
-            ((c, s, 0.0), (-s, c, 0.0), (0.0, 0.0, 1.0)),
-            (
-                (-truck.half_length, truck.half_length),
-                (-truck.half_width, truck.half_width),
-                (truck.floor, truck.height),
-            ),
+        self._truck_body = _floats(
+            bodies.box_from_ranges(
+                (truck.cx, truck.cy, 0.0),
+                ((c, s, 0.0), (-s, c, 0.0), (0.0, 0.0, 1.0)),
+                (
+                    (-truck.half_length, truck.half_length),
+                    (-truck.half_width, truck.half_width),
+                    (truck.floor, truck.height),
+                ),
+            )
         )
 
     def _ground_and_body_bounds(self, scene, base) -> None:
         """The ground plane under the base, the relief bound, and the house's, the
         bucket's and the tracks' fixed bounds."""
-        self._gx, self._gy = ground_plane(base)
+        self._gx, self._gy = _floats(ground_plane(base))
         self._plane = self._gx * CELL_XS[:, None] + self._gy * CELL_YS[None, :]
         # + 0.01 m: the plane's change within a cell (the map holds cell centres).
         self._relief_max = float((scene.heights - self._plane).max()) + 0.01
         tilt = math.hypot(self._gx, self._gy)
         # The plane's change from a cell's centre to its corners, and the map's extent.
-        self._cell_tilt = 0.5 * GRID_CELL * (abs(self._gx) + abs(self._gy)) + SKIP
+        self._cell_tilt = float(0.5 * GRID_CELL * (abs(self._gx) + abs(self._gy)) + SKIP)
         nx, ny = GRID_SHAPE
         self._map_xy = (
             (GRID_ORIGIN[0], GRID_ORIGIN[0] + nx * GRID_CELL),
@@ -451,6 +456,17 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def _spill_on_ground(self, x: float, y: float, amount: float) -> None:
         """Loose soil (m3) returns to the ground as bank volume, ``amount / swell``."""
         self._deposit(x, y, amount / self.m.swell)
+
+
+def _floats(value):
+    """``value`` (a number, or tuples, named tuples and capsules of them) with every
+    number a Python float: the same doubles."""
+    if isinstance(value, bodies.Capsule):
+        return bodies.Capsule(_floats(value.a), _floats(value.b), float(value.radius))
+    if isinstance(value, tuple):
+        items = [_floats(v) for v in value]
+        return type(value)(*items) if hasattr(value, "_fields") else tuple(items)
+    return float(value)
 
 
 def _rotator(rotation):
