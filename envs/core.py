@@ -216,7 +216,15 @@ def reward_and_info(
     return add_reward_terms(info, terms), info
 
 
-_REWARD_KEYS: dict[str, str] = {}  # term -> "reward_<term>", made once per name
+class _RewardKeys(dict):
+    """term -> ``"reward_<term>"``, each made once (on its first use)."""
+
+    def __missing__(self, term: str) -> str:
+        key = self[term] = f"reward_{term}"
+        return key
+
+
+_REWARD_KEYS = _RewardKeys()
 
 
 def add_reward_terms(info: dict[str, Any], terms: Mapping[str, float]) -> float:
@@ -225,10 +233,7 @@ def add_reward_terms(info: dict[str, Any], terms: Mapping[str, float]) -> float:
     :func:`reward_and_info`."""
     keys = _REWARD_KEYS
     for key, value in terms.items():
-        name = keys.get(key)
-        if name is None:
-            name = keys[key] = f"reward_{key}"
-        info[name] = float(value)
+        info[keys[key]] = float(value)
     return float(sum(terms.values()))
 
 

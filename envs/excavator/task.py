@@ -11,12 +11,16 @@ observation) and ``measures(world)`` (the task's ``info`` keys).
 from __future__ import annotations
 
 import math
+import struct
 from typing import Any
 
 import numpy as np
 
 from motiongym.envs.excavator.params import DigParams, ReachParams
 from motiongym.envs.excavator.scenes import Scene, sample_dig_scene, sample_reach_scene
+
+# target_error written as float32 straight into the observation (NumPy's rounding).
+_ERROR = struct.Struct("=4f")
 
 
 class ReachTask:
@@ -30,30 +34,44 @@ class ReachTask:
         self.p = params
         self.w = params.weights
         self.layout = layout
-        self._error_index = layout["target_error"].start
+        self._error_offset = 4 * layout["target_error"].start  # bytes into the float32 buffer
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
         return sample_reach_scene(rng, self.p.machine, self.p.slope)
 
     def errors(self, world) -> tuple[float, float]:
-        """``(position error m, bucket angle error rad)`` of the tip against the target."""
-        t = world.scene.target
-        pos = math.dist(world.tip, (t[0], t[1], t[2]))
-        ang = abs(math.remainder(world.beta - t[3], 2 * math.pi))
+        """``(position error m, bucket angle error rad)`` of the tip against the target.
+
+        Kept for the pose it was computed at (the step's reward and ``info`` both read it).
+        """
+        tip, beta = world.tip, world.beta
+        memo = self._errors
+        if memo[0] is tip and memo[1] == beta:
+            return memo[2]
+        t = self._target
+        pos = math.dist(tip, t[:3])
+        ang = abs(math.remainder(beta - t[3], 2 * math.pi))
+        self._errors = (tip, beta, (pos, ang))
         return pos, ang
 
     def reset(self, world, buf: np.ndarray) -> None:
         buf[self.layout["target"]] = world.scene.target
+        # The target as Python floats (the same doubles; NumPy scalars cost more per operation).
+        self._target = tuple(float(x) for x in world.scene.target)
+        self._errors: tuple = (None, None, None)
         pos, ang = self.errors(world)
         self._err = pos + ang
 
     def write(self, world, buf: np.ndarray) -> None:
-        t, tip = world.scene.target, world.tip
-        i = self._error_index
-        buf[i] = t[0] - tip[0]
-        buf[i + 1] = t[1] - tip[1]
-        buf[i + 2] = t[2] - tip[2]
-        buf[i + 3] = math.remainder(t[3] - world.beta, 2 * math.pi)
+        t, tip = self._target, world.tip
+        _ERROR.pack_into(
+            buf,
+            self._error_offset,
+            t[0] - tip[0],
+            t[1] - tip[1],
+            t[2] - tip[2],
+            math.remainder(t[3] - world.beta, 2 * math.pi),
+        )
 
     def step(self, world) -> tuple[dict[str, float], bool]:
         w, p = self.w, self.p
