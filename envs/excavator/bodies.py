@@ -131,6 +131,9 @@ class Box(NamedTuple):
         return all(abs(x) <= h for x, h in zip(self.local(p), self.half, strict=True))
 
 
+_new_box = tuple.__new__  # Box(...) without the named tuple's Python-level __new__
+
+
 def box_from_ranges(origin: Vec, axes, ranges) -> Box:
     """The box spanning ``ranges`` ((lo, hi) per axis) along ``axes`` from ``origin``."""
     (l0, h0), (l1, h1), (l2, h2) = ranges
@@ -142,7 +145,7 @@ def box_from_ranges(origin: Vec, axes, ranges) -> Box:
         origin[2] + sum((m0 * a[2], m1 * b[2], m2 * c[2])),
     )
     half = (0.5 * (h0 - l0), 0.5 * (h1 - l1), 0.5 * (h2 - l2))
-    return Box(centre, (tuple(a), tuple(b), tuple(c)), half)
+    return _new_box(Box, (centre, (tuple(a), tuple(b), tuple(c)), half))
 
 
 def segment_to_box(a, b, box: Box, above: float = math.inf) -> float:
