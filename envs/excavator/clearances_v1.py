@@ -74,17 +74,28 @@ class ClearancesV1:
         return best
 
     def _truck_clearance(self, cache: dict, lows, plan) -> float:
+        """The house (its fixed bound, then its sphere's), then boom, stick and bucket."""
         box, best = self._truck_body, self._house_truck
         if best < SELF_HORIZON:
-            best = self._exact(cache, "house", box, box.gap, SELF_HORIZON)
-        radius, height = self._truck_radius, self._truck_height
-        for k, name in enumerate(PARTS):
+            c, r = self._sphere(cache, "house")
+            best = box.gap(c) - r
+            if best < SELF_HORIZON:
+                best = self._box_distance(cache, "house", box, SELF_HORIZON, math.inf)
+        radius, height, pts = self._truck_radius, self._truck_height, self.points
+        for k in range(3):
             gap, above = plan[k] - radius, lows[k] - height
-            d = (above if above > gap else gap) - REACH[k]
+            reach = REACH[k]
+            d = (above if above > gap else gap) - reach
             if d < HORIZON:
                 if d - best >= SKIP:
                     continue
-                d = self._exact(cache, name, box, box.gap, HORIZON, best)
+                if k < 2:  # a link's capsule
+                    d = bodies.segment_to_box(pts[k], pts[k + 1], box, best + reach) - reach
+                else:  # the bucket: its sphere's bound, then its box
+                    c, r = self._sphere(cache, "bucket")
+                    d = box.gap(c) - r
+                    if d < HORIZON and d - self._bucket_slack - best < SKIP:
+                        d = self._box_distance(cache, "bucket", box, HORIZON, best)
             if d < best:
                 best = d
         return best

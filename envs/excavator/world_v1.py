@@ -36,6 +36,7 @@ stopped a part other than the cutting edge) is reported, not ended on.
 
 from __future__ import annotations
 
+import functools
 import math
 from math import cos, sin
 
@@ -470,16 +471,16 @@ def _floats(value):
 
 
 def _rotator(rotation):
-    """``v -> R v`` for the rows of ``rotation`` (None: level, no rotation is applied)."""
+    """``v -> R v`` for the rows of ``rotation`` (None: level, no rotation is applied);
+    a partial of :func:`_turn` (picklable, as the environments are)."""
     if rotation is None:
         return None
-    (a, b, c), (d, e, f), (g, h, i) = rotation
+    return functools.partial(_turn, *rotation[0], *rotation[1], *rotation[2])
 
-    def turn(v) -> tuple[float, float, float]:
-        x, y, z = v
-        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
 
-    return turn
+def _turn(a, b, c, d, e, f, g, h, i, v) -> tuple[float, float, float]:
+    x, y, z = v
+    return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
 
 
 def _lerp(a, b, t: float) -> list[float]:
