@@ -227,13 +227,13 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
     iy = lambda y: min(max(int((y - GRID_ORIGIN[1]) / GRID_CELL), 0), GRID_SHAPE[1] - 1)  # noqa: E731
     for _ in range(10_000):
         q = rng.uniform(lo, hi)
-        pts = arm_points(*q, m)
-        if not level:
-            pts = tuple(tuple(rotation @ p) for p in pts)
-        tip = pts[-1]
+        pts = arm_points(*q.tolist(), m)  # Python floats: the same doubles, cheaper
+        tip = pts[-1] if level else tuple(rotation @ pts[-1])
         ground = heights[ix(tip[0]), iy(tip[1])]
         if math.hypot(tip[0], tip[1]) < 4.0 or not 0.0 <= tip[2] - ground <= 2.5:
-            continue
+            continue  # (most candidates: the other points are turned only past this test)
+        if not level:
+            pts = (*(tuple(rotation @ p) for p in pts[:-1]), tip)
         if any(p[2] < heights[ix(p[0]), iy(p[1])] + 0.3 for p in pts[1:3]):
             continue
         if truck_clearance(pts, m.link_radius, truck) < 1.0:
