@@ -215,3 +215,54 @@ def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
     config.write_text(yaml.safe_dump({"sac": block}))
     with pytest.raises(UsageError, match="cannot use replay_buffer_class her"):
         train(env_id, "sac", config, out_root=tmp_path, progress=False)
+
+
+def _shipped_residuals() -> list[tuple[str, str]]:
+    from motiongym.agents.pretrained import METRICS, pretrained_models
+    from motiongym.envs import ENV_IDS
+
+    return [
+        (env_id, name)
+        for env_id in ENV_IDS
+        for name, folder in pretrained_models(env_id).items()
+        if json.loads((folder / METRICS).read_text()).get("kind") == "residual"
+    ]
+
+
+class _NoCorrection:
+    """A learned part that always proposes no correction (the ablation)."""
+
+    def __init__(self, shape: tuple[int, ...]) -> None:
+        self.shape = shape
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return np.zeros(self.shape, np.float32), state
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("env_id", "name"), _shipped_residuals())
+def test_a_shipped_residual_agent_without_its_correction_is_its_teacher(env_id, name):
+    """The ablation of a shipped residual agent on its first three held-out episodes: with the
+    correction it repeats the episodes in metrics.json; switched off it repeats the scripted
+    policy's episodes exactly (the difference between the two is the learned part's)."""
+    import yaml
+
+    from motiongym.agents.environments import make_env
+    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.predictors import load_predictor
+    from motiongym.agents.pretrained import METRICS, pretrained_models
+
+    folder = pretrained_models(env_id)[name]
+    metrics = json.loads((folder / METRICS).read_text())
+    shipped = next(run for run in metrics["runs"] if run["run"] == metrics["shipped_run"])
+    seeds = metrics["held_out_seeds"][:3]
+    env = make_env(env_id)
+    agent = load_predictor(name, env_id, env)
+    on = evaluate(env, agent, seeds, env_id, name, progress=False).episodes
+    for episode, recorded in zip(on, shipped["episodes"][:3], strict=True):
+        assert episode == pytest.approx(recorded, rel=1e-6)
+    teacher_name = yaml.safe_load((folder / "config.yml").read_text())["residual"]
+    teacher = load_predictor(teacher_name, env_id, env)
+    agent.learned = _NoCorrection(env.action_space.shape)
+    off = evaluate(env, agent, seeds, env_id, "off", progress=False).episodes
+    assert off == evaluate(env, teacher, seeds, env_id, "teacher", progress=False).episodes
