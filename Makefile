@@ -58,6 +58,9 @@ lint: $(STAMP)
 # evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
 SEEDS ?= 0 1 2
 IDS ?= Sweeper-v0 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
+# Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
+# as <algo>-residual.
+RESIDUAL_IDS ?= Excavator-v1 ExcavatorReach-v1
 models: $(STAMP)
 	for id in $(IDS); do \
 	  for seed in $(SEEDS); do \
@@ -70,6 +73,13 @@ models: $(STAMP)
 	    --config configs/DualArmCell-v0-shared.yml --out runs/models-shared || exit 1; \
 	done
 	$(BIN)/motiongym ship runs/models-shared/DualArmCell-v0/ppo_seed*
+	for id in $(RESIDUAL_IDS); do \
+	  for seed in $(SEEDS); do \
+	    $(BIN)/motiongym train motiongym/$$id --seed $$seed \
+	      --config configs/$$id-residual.yml --out runs/models-residual || exit 1; \
+	  done; \
+	  $(BIN)/motiongym ship runs/models-residual/$$id/*_seed* --episodes 50 || exit 1; \
+	done
 
 # BENCHMARKS.md's tables and figures, from the shipped models' metrics.
 benchmarks: $(STAMP)

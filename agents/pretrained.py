@@ -77,7 +77,8 @@ def verify_manifest(folder: Path, required: tuple[str, ...] = ()) -> None:
 
 
 def pretrained_models(env_id: str) -> dict[str, Path]:
-    """``{label: folder}`` of the models shipped for ``env_id`` (label ``<algo>``)."""
+    """``{label: folder}`` of the models shipped for ``env_id`` (label ``<algo>``, with
+    ``-shared`` or ``-residual`` appended: :func:`~motiongym.agents.ship.shipped_label`)."""
     root = pretrained_root() / short_name(env_id)
     if not root.is_dir():
         return {}

@@ -13,6 +13,13 @@ observation is unchanged, so SB3 trains the residual with its usual
 algorithms; ``info["base_action"]`` is ``pi_0(s)``. :class:`ResidualPredictor`
 acts the same way outside the wrapper (evaluation of a trained residual
 agent: ``motiongym train`` with ``residual: <policy>`` in the config block).
+
+Silver et al. initialise the residual's last layer to zero, so that the
+untrained agent is exactly ``pi_0``; :func:`zero_correction` does so for SB3's
+policies (``motiongym train`` calls it on every residual run). Without it an
+untrained SAC actor's most likely correction is ``tanh`` of a random linear
+map of the observation, not zero (docs/experiments/Excavator-v1.md measures
+what that costs the teacher).
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+import torch
 from gymnasium import spaces
 
 from motiongym.baselines import make_policy
@@ -95,3 +103,30 @@ class ResidualPredictor:
         correction, state = self.learned.predict(observation, state, episode_start, deterministic)
         base, _ = self.policy.predict(observation, None, episode_start, True)
         return _combined(base, correction, self.scale, self.box), state
+
+
+def zero_correction(model: Any) -> None:
+    """Zero the last linear layer of ``model``'s action output (Silver et al. 2018).
+
+    The mean (PPO, A2C: ``policy.action_net``) or pre-``tanh`` output (SAC,
+    TQC: ``actor.mu``; TD3, DDPG: the last ``Linear`` of ``actor.mu``) becomes
+    exactly 0 for every observation, so the deterministic correction is 0 and
+    the agent acts as its scripted policy until it learns; the layer's
+    gradient (the layer below's output times the loss's) is not zero, so it
+    learns. The exploration noise (SAC's ``log_std``, PPO's ``log_std``) is
+    left as SB3 sets it.
+    """
+    policy = model.policy
+    head = getattr(getattr(policy, "actor", None), "mu", None)
+    if head is None:
+        head = getattr(policy, "action_net", None)
+    if isinstance(head, torch.nn.Sequential):
+        head = next((m for m in reversed(head) if isinstance(m, torch.nn.Linear)), None)
+    if not isinstance(head, torch.nn.Linear):
+        raise ValueError(
+            f"model must have a linear action output (actor.mu or action_net), got "
+            f"{type(model).__name__} with {type(head).__name__}"
+        )
+    with torch.no_grad():
+        head.weight.zero_()
+        head.bias.zero_()

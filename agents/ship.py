@@ -29,8 +29,17 @@ from motiongym.agents.pretrained import (
 
 def shipped_label(config: dict) -> str:
     """The folder name of a run's model under its ID: the algorithm, ``-shared`` for a
-    shared-parameter multi-agent run (``vec_env: pettingzoo``)."""
-    return config["algo"] + ("-shared" if config.get("vec_env") == "pettingzoo" else "")
+    shared-parameter multi-agent run (``vec_env: pettingzoo``), ``-residual`` for a
+    correction of a scripted policy (``residual: <policy>``)."""
+    if config.get("vec_env") == "pettingzoo":
+        return config["algo"] + "-shared"
+    return config["algo"] + ("-residual" if config.get("residual") else "")
+
+
+def agent_kind(config: dict) -> str:
+    """What a shipped agent is, for ``metrics.json``'s ``kind``: ``residual`` (it acts
+    through a scripted policy), else ``learned`` (it acts alone)."""
+    return "residual" if config.get("residual") else "learned"
 
 
 def _run_config(run_dir: Path) -> dict:
@@ -166,6 +175,7 @@ def ship(
     metrics = {
         "env_id": env_id,
         "policy": label,
+        "kind": agent_kind(configs[best]),
         "shipped_run": runs[best]["run"],
         "held_out_seeds": list(seeds),
         "pooled": pooled.summary(),

@@ -74,7 +74,7 @@ from motiongym.agents.model_files import (
 from motiongym.agents.multiagent import SharedPolicyVecEnv, parallel_factory
 from motiongym.agents.predictors import CONFIG_FILE, MODEL_FILE
 from motiongym.agents.pretrained import write_manifest
-from motiongym.agents.residual import ResidualWrapper
+from motiongym.agents.residual import ResidualWrapper, zero_correction
 from motiongym.agents.vector import VectorEnvAdapter
 from motiongym.baselines import scripted_policies
 from motiongym.envs.core import ArgumentError, check_int
@@ -293,6 +293,8 @@ def train(
             # checks of spaces and policy; a policy_kwargs or features_extractor_kwargs key
             # it lacks (TypeError) or a layer size torch refuses (RuntimeError)
             raise UsageError(f"{algo} cannot train on {env_id}: {error}") from error
+        if config["residual"]:  # the untrained agent acts as the scripted policy
+            zero_correction(model)
         if config["demonstrations"]:
             _clone(env_id, config, model, venv, seed, run_dir)
         eval_dir = run_dir / "eval"

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import json
+
 import gymnasium as gym
 import numpy as np
 import pytest
 import torch
 from stable_baselines3 import PPO, SAC
 
-from motiongym.agents.residual import ResidualWrapper
+from motiongym.agents.residual import ResidualPredictor, ResidualWrapper, zero_correction
 from motiongym.baselines import make_policy
 
 REACH = "motiongym/ExcavatorReach-v1"
@@ -39,6 +41,34 @@ def test_residual_with_zero_correction_is_the_scripted_policy():
     np.testing.assert_array_equal(applied, actions)
     np.testing.assert_array_equal(obs, last)
     assert terminated and step_info["is_success"] == info["is_success"] is True
+
+
+@pytest.mark.parametrize("algorithm", [SAC, PPO])
+def test_zero_correction_makes_the_untrained_agent_its_scripted_policy(algorithm):
+    """Silver et al.'s initialisation: after zero_correction the untrained agent's action is
+    the scripted one, step by step; SB3's own initialisation (the ablation) moves it."""
+    actions, _, _ = _scripted_episode(REACH, "newton-raphson-reach", seed=100_000)
+    env = gym.make(REACH)
+    scripted = make_policy(
+        REACH, "newton-raphson-reach", env.observation_space, env.action_space, env.spec.kwargs
+    )
+    wrapped = ResidualWrapper(gym.make(REACH), "newton-raphson-reach", 0.3)
+    acted = {}
+    for init in ("sb3", "zero"):
+        model = algorithm("MlpPolicy", wrapped, seed=0, device="cpu")
+        if init == "zero":
+            zero_correction(model)
+        predictor = ResidualPredictor(model, scripted, 0.3, env.action_space)
+        obs, _ = env.reset(seed=100_000)
+        acted[init] = []
+        for t in range(len(actions)):
+            action, _ = predictor.predict(obs, episode_start=np.array([t == 0]))
+            obs, *_ = env.step(action)
+            acted[init].append(action)
+    np.testing.assert_array_equal(acted["zero"], actions)
+    assert np.abs(np.array(acted["sb3"][0]) - actions[0]).max() > 1e-3
+    with pytest.raises(ValueError, match="linear action output"):
+        zero_correction(type("Model", (), {"policy": object()})())
 
 
 def test_residual_correction_is_scaled_and_clipped_to_the_action_box():
@@ -107,6 +137,7 @@ def test_a_residual_run_trains_and_evaluates_with_its_scripted_policy(tmp_path):
     from motiongym.agents.evaluate import evaluate
     from motiongym.agents.predictors import load_predictor
     from motiongym.agents.residual import ResidualPredictor
+    from motiongym.agents.ship import ship
     from motiongym.agents.train import train
 
     config = tmp_path / "residual.yml"
@@ -120,6 +151,10 @@ def test_a_residual_run_trains_and_evaluates_with_its_scripted_policy(tmp_path):
     predictor = load_predictor(str(run_dir), REACH, env)
     assert isinstance(predictor, ResidualPredictor) and predictor.scale == 0.3
     assert 0 < evaluate(env, predictor, [2], REACH, "res", progress=False).episodes[0]["length"]
+    shipped = ship([run_dir], n_episodes=1, root=tmp_path / "pretrained")
+    assert shipped.folder.name == "sac-residual"  # the label says the kind, as metrics.json
+    assert json.loads((shipped.folder / "metrics.json").read_text())["kind"] == "residual"
+    assert isinstance(load_predictor(str(shipped.folder), REACH, env), ResidualPredictor)
     config.write_text(config.read_text().replace("newton-raphson-reach", "potential-field"))
     with pytest.raises(UsageError, match="not a scripted policy of motiongym/ExcavatorReach-v1"):
         train(REACH, "sac", config, out_root=tmp_path, progress=False)
@@ -180,3 +215,54 @@ def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
     config.write_text(yaml.safe_dump({"sac": block}))
     with pytest.raises(UsageError, match="cannot use replay_buffer_class her"):
         train(env_id, "sac", config, out_root=tmp_path, progress=False)
+
+
+def _shipped_residuals() -> list[tuple[str, str]]:
+    from motiongym.agents.pretrained import METRICS, pretrained_models
+    from motiongym.envs import ENV_IDS
+
+    return [
+        (env_id, name)
+        for env_id in ENV_IDS
+        for name, folder in pretrained_models(env_id).items()
+        if json.loads((folder / METRICS).read_text()).get("kind") == "residual"
+    ]
+
+
+class _NoCorrection:
+    """A learned part that always proposes no correction (the ablation)."""
+
+    def __init__(self, shape: tuple[int, ...]) -> None:
+        self.shape = shape
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return np.zeros(self.shape, np.float32), state
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("env_id", "name"), _shipped_residuals())
+def test_a_shipped_residual_agent_without_its_correction_is_its_teacher(env_id, name):
+    """The ablation of a shipped residual agent on its first three held-out episodes: with the
+    correction it repeats the episodes in metrics.json; switched off it repeats the scripted
+    policy's episodes exactly (the difference between the two is the learned part's)."""
+    import yaml
+
+    from motiongym.agents.environments import make_env
+    from motiongym.agents.evaluate import evaluate
+    from motiongym.agents.predictors import load_predictor
+    from motiongym.agents.pretrained import METRICS, pretrained_models
+
+    folder = pretrained_models(env_id)[name]
+    metrics = json.loads((folder / METRICS).read_text())
+    shipped = next(run for run in metrics["runs"] if run["run"] == metrics["shipped_run"])
+    seeds = metrics["held_out_seeds"][:3]
+    env = make_env(env_id)
+    agent = load_predictor(name, env_id, env)
+    on = evaluate(env, agent, seeds, env_id, name, progress=False).episodes
+    for episode, recorded in zip(on, shipped["episodes"][:3], strict=True):
+        assert episode == pytest.approx(recorded, rel=1e-6)
+    teacher_name = yaml.safe_load((folder / "config.yml").read_text())["residual"]
+    teacher = load_predictor(teacher_name, env_id, env)
+    agent.learned = _NoCorrection(env.action_space.shape)
+    off = evaluate(env, agent, seeds, env_id, "off", progress=False).episodes
+    assert off == evaluate(env, teacher, seeds, env_id, "teacher", progress=False).episodes
