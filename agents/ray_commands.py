@@ -87,7 +87,7 @@ def add_ray_commands(commands, count, seed, folder) -> None:  # argparse's subpa
     sweep.set_defaults(handler=cmd_sweep)
 
     rllib = commands.add_parser(
-        "rllib", help="RLlib PPO on one ID from configs/rllib.yml (motiongym[ray])"
+        "rllib", help="RLlib PPO on one ID from configs/rllib/ppo.yml (motiongym[ray])"
     )
     rllib.add_argument("env_id", help=f"environment ID, one of {', '.join(ENV_IDS[:2])}, ...")
     rllib.add_argument("--iterations", type=count, default=10, help="PPO iterations (default 10)")
@@ -97,7 +97,7 @@ def add_ray_commands(commands, count, seed, folder) -> None:  # argparse's subpa
         help="the ID's PettingZoo env, one policy shared by its agents "
         "(default: the Gymnasium env)",
     )
-    rllib.add_argument("--config", type=Path, help="YAML file (default: configs/rllib.yml)")
+    rllib.add_argument("--config", type=Path, help="YAML file (default: configs/rllib/ppo.yml)")
     rllib.add_argument("--seed", type=seed, default=0, help="seed (default 0)")
     rllib.add_argument(
         "--out", type=folder, default=Path("runs/rllib"), help="folder (default runs/rllib)"

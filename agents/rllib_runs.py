@@ -1,4 +1,4 @@
-"""RLlib: every ID in RLlib's environment registry, and PPO on one ID from ``configs/rllib.yml``.
+"""RLlib: every ID in RLlib's environment registry, and PPO on one ID from ``configs/rllib/ppo.yml``.
 
 Ray is the optional extra ``motiongym[ray]``. RLlib spreads one run's
 sampling over ``num_env_runners`` Ray workers (on a cluster: over its
@@ -38,7 +38,7 @@ SHARED_POLICY = "shared"
 
 
 def default_rllib_config() -> Path:
-    return Path(str(resources.files("motiongym.configs") / "rllib.yml"))
+    return Path(str(resources.files("motiongym.configs") / "rllib" / "ppo.yml"))
 
 
 def make_single(env_id: str, env_config: dict[str, Any]) -> gym.Env:
