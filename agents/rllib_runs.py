@@ -1,4 +1,4 @@
-"""RLlib: every ID in RLlib's environment registry, and PPO on one ID from ``configs/rllib/ppo.yml``.
+"""RLlib: every ID in RLlib's environment registry; PPO on one ID from ``configs/rllib/ppo.yml``.
 
 Ray is the optional extra ``motiongym[ray]``. RLlib spreads one run's
 sampling over ``num_env_runners`` Ray workers (on a cluster: over its
