@@ -227,7 +227,7 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
     iy = lambda y: min(max(int((y - GRID_ORIGIN[1]) / GRID_CELL), 0), GRID_SHAPE[1] - 1)  # noqa: E731
     for _ in range(10_000):
         q = rng.uniform(lo, hi)
-        pts = arm_points(*q, m)
+        pts = arm_points(q[0], q[1], q[2], q[3], m)
         if not level:
             pts = tuple(tuple(rotation @ p) for p in pts)
         tip = pts[-1]
