@@ -51,3 +51,23 @@ def test_the_buried_pipe_shows_through_the_ground(reach):
     assert cols.max() - cols.min() > 200  # pixels: across a third of the frame
     shift = (shown.astype(int) - hidden.astype(int))[changed].mean(axis=0)  # (3,) RGB
     assert shift[2] > 40 and shift[2] > 3 * shift[0]  # the ground turns blue over it
+
+
+def _coloured_extent(frame: np.ndarray) -> tuple[float, float]:
+    """Width and height (fractions of the frame's) of the box around the coloured pixels:
+    arm, fruit and obstacles (the floor is grey, the sky black)."""
+    f = frame.astype(int)
+    rows, cols = np.nonzero(f.max(axis=2) - f.min(axis=2) > 40)
+    return (cols.max() - cols.min()) / f.shape[1], (rows.max() - rows.min()) / f.shape[0]
+
+
+def test_the_spatial_harvest_scene_fills_the_frame():
+    extents = []
+    for seed in range(4):
+        env = gym.make("motiongym/HarvestArm-v0", render_mode="rgb_array")
+        env.reset(seed=seed)
+        extents.append(_coloured_extent(env.render()))
+        env.close()
+    width, height = np.mean(extents, axis=0)
+    # the former camera (1.7 m away, 20 degrees down): 0.36 of the width, 0.55 of the height
+    assert width > 0.45 and height > 0.65
