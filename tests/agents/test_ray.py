@@ -31,16 +31,6 @@ needs_ray = pytest.mark.skipif(
     ray is None, reason="Ray is the optional extra motiongym[ray] (make test-ray installs it)"
 )
 
-TINY = """
-ppo:
-  n_envs: 1
-  n_timesteps: 64
-  policy: MlpPolicy
-  n_steps: 64
-  batch_size: 32
-  eval_freq: 32
-  n_eval_episodes: 1
-"""
 TINY_RLLIB = {
     "training": {"train_batch_size_per_learner": 200, "minibatch_size": 100, "num_epochs": 1},
     "env_runners": {"num_env_runners": 0},
@@ -57,7 +47,7 @@ def test_without_ray_the_commands_say_how_to_install_it(monkeypatch, capsys, com
 
 def test_the_trial_grid_is_ids_by_configs_by_seeds_with_absolute_paths(tmp_path):
     a, b = tmp_path / "a.yml", tmp_path / "b.yml"
-    a.write_text(TINY), b.write_text(TINY)
+    a.write_text("ppo: {}\n"), b.write_text("ppo: {}\n")  # files that exist
     ids = ["motiongym/Sweeper-v0", "motiongym/HarvestArm-v0"]
     specs = trial_specs(ids, [a, b, None], [0, 5], Path("rel"), timesteps=100)
     assert len(specs) == 2 * 3 * 2
@@ -72,7 +62,7 @@ def test_the_trial_grid_is_ids_by_configs_by_seeds_with_absolute_paths(tmp_path)
 
 def test_bad_sweeps_are_refused_by_name(tmp_path):
     (tmp_path / "x").mkdir()
-    (tmp_path / "a.yml").write_text(TINY), (tmp_path / "x" / "a.yml").write_text(TINY)
+    (tmp_path / "a.yml").write_text("ppo: {}\n"), (tmp_path / "x" / "a.yml").write_text("ppo: {}\n")
     with pytest.raises(UsageError, match="unknown environment ID 'Nope-v0'"):
         trial_specs(["Nope-v0"], [None], [0], tmp_path)
     with pytest.raises(UsageError, match="two files share a name"):
@@ -150,12 +140,12 @@ def local_ray():
 
 @needs_ray
 @pytest.mark.slow
-def test_a_tiny_sweep_on_a_local_ray_writes_run_folders_and_ship_commands(tmp_path, local_ray):
+def test_a_tiny_sweep_on_a_local_ray_writes_run_folders_and_ship_commands(
+    tmp_path, local_ray, tiny_config
+):
     from motiongym.agents.sweep import SWEEP_FILE, sweep
 
-    config = tmp_path / "tiny.yml"
-    config.write_text(TINY)
-    specs = trial_specs(["motiongym/ExcavatorReach-v0"], [config], [0, 1], tmp_path / "out")
+    specs = trial_specs(["motiongym/ExcavatorReach-v0"], [tiny_config], [0, 1], tmp_path / "out")
     groups = sweep(specs, tmp_path / "out")
     (group,) = groups.values()
     assert group["seeds"] == [0, 1]
