@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 EPISODES ?= 10
 
-.PHONY: install demo test test-slow lint models benchmarks fuzz docs
+.PHONY: install demo test test-slow lint models benchmarks fuzz docs test-ray test-zoo
 
 $(STAMP): pyproject.toml setup.py
 	python3 -m venv $(VENV)
@@ -40,6 +40,24 @@ docs: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[docs]"
 	MUJOCO_GL=egl $(BIN)/sphinx-build -W --keep-going -q -b html docs/site docs/site/_build/html
 	@echo "docs/site/_build/html/index.html"
+
+# Ray (the optional extra motiongym[ray]: `motiongym sweep`, `motiongym rllib`): installs
+# it, then runs tests/agents/test_ray.py with its slow tests (a local Ray head on
+# 127.0.0.1: one tiny sweep, one tiny RLlib iteration per route). Not part of make test.
+test-ray: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e ".[ray]"
+	MUJOCO_GL=egl $(BIN)/pytest -q -m "slow or not slow" tests/agents/test_ray.py
+
+# rl-zoo3 trains every block of configs/zoo/*.yml for a few hundred steps with its own
+# train script, and motiongym evaluates a zoo run (tests/agents/test_zoo_train.py). The zoo
+# is not a dependency (through moviepy it downgrades pillow): it goes in its own virtual
+# environment, .venv-zoo, never in .venv. About 4 min after the install.
+ZOO_VENV := .venv-zoo
+test-zoo:
+	test -x $(ZOO_VENV)/bin/python || python3 -m venv $(ZOO_VENV)
+	$(ZOO_VENV)/bin/python -m pip install --quiet torch==2.13.0
+	$(ZOO_VENV)/bin/python -m pip install --quiet -e ".[dev]" "rl_zoo3>=2.9,<3"
+	MUJOCO_GL=egl $(ZOO_VENV)/bin/pytest -q -m slow -p no:cacheprovider tests/agents/test_zoo_train.py
 
 # The type check (mypy, [tool.mypy] in pyproject.toml) of envs/ and baselines/ reads the
 # package through links in build/typecheck: setup.py maps the folders to the import name

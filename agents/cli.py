@@ -1,5 +1,5 @@
 """The ``motiongym`` command: list, evaluate, compare, train, dataset, ship, record, benchmarks,
-reproduce, bench.
+reproduce, bench; sweep and rllib (Ray, :mod:`motiongym.agents.ray_commands`).
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
 malformed YAML file, a model built for another space) ends in one line on
@@ -470,6 +470,10 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", type=_folder, default=Path("results/bench"), help="folder (default results/bench)"
     )
     bench.set_defaults(handler=cmd_bench)
+
+    from motiongym.agents.ray_commands import add_ray_commands
+
+    add_ray_commands(commands, _count, _seed, _folder)
     return parser
 
 

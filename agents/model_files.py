@@ -209,6 +209,14 @@ def _schedule(value: float):
     return ConstantSchedule(float(value))
 
 
+def _plain_rate(entry: Any) -> float:
+    """A learning rate saved as a number, or as SB3's ``ConstantSchedule`` (its ``val``)."""
+    if isinstance(entry, (int, float)):
+        return float(entry)
+    value = entry.get("val") if isinstance(entry, dict) else None
+    return float(value) if isinstance(value, (int, float)) else 0.0
+
+
 def load_archive(
     path: Path,
     observation_space: spaces.Space,
@@ -236,6 +244,9 @@ def load_archive(
         "observation_space": observation_space,
         "action_space": action_space,
         "lr_schedule": _schedule(rate if isinstance(rate, (int, float)) else 0.0),
+        # rl-zoo3 saves the rate as a schedule object (its plain "val" beside the pickle);
+        # a rate plays no part in acting, so any other schedule becomes 0.
+        "learning_rate": _schedule(_plain_rate(rate)),
         "target_entropy": float(-np.prod(action_space.shape)),  # SB3's "auto"
         "clip_range": _schedule(0.2),
         "clip_range_vf": None,

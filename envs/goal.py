@@ -196,13 +196,18 @@ class GoalConditionedEnv(gym.Env):
         self.collision = check_float("collision", collision, 0.0, 1e6)
         self.cost = check_float("cost", cost, 0.0, 1e6)
         self.base_id, base_kwargs, self.fields = resolve({"base": base, "fields": fields, **kw})
-        self.base = load_env_creator(gym.spec(base).entry_point)(**base_kwargs)
+        entry = gym.spec(base).entry_point
+        if entry is None:
+            raise ValueError(f"base {base} has no entry point")
+        self.base = (load_env_creator(entry) if isinstance(entry, str) else entry)(**base_kwargs)
         self.base.spec = gym.spec(base)  # its window, where human, says which world
         self.metadata = self.base.metadata
         self.dt = getattr(self.base, "dt", None)  # s, the base's control period
         self.render_mode = self.base.render_mode
         self.action_space = self.base.action_space
         box, f = self.base.observation_space, self.fields
+        if not isinstance(box, spaces.Box):
+            raise ValueError(f"base {base} observes a {type(box).__name__}, not a Box")
         if box.shape != (f.base_size,):
             raise ValueError(f"{fields} describes {f.base_size} values, {base} has {box.shape}")
 

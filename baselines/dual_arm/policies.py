@@ -129,7 +129,8 @@ class SchedulePolicy(ScriptedPolicy):
         obs = np.asarray(observation, dtype=float)
         if memory["schedule"] is None:
             memory["tasks"] = tasks_from_observation(obs)
-            memory["schedule"] = self._plan_verified(*memory["tasks"], memory)
+            traj1, traj2 = memory["tasks"]
+            memory["schedule"] = self._plan_verified(traj1, traj2, memory)
         step = int(round(float(obs[OBS["elapsed"]][0]) / DT))
         adv = memory["schedule"].advances
         a2 = float(adv[step]) if step < len(adv) else 1.0
@@ -150,7 +151,8 @@ class BoundaryFollowingPolicy(SchedulePolicy):
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
         if self.swept:
-            found = exact_delay_search(*memory["tasks"], self.n_levels, memory["margin"])
+            traj1, traj2 = memory["tasks"]
+            found = exact_delay_search(traj1, traj2, self.n_levels, memory["margin"])
             memory.update(result=found, fallback=found.delay is None, reason=found.reason)
             if found.delay is None:
                 return schedules.sequential(cmap)
@@ -159,7 +161,8 @@ class BoundaryFollowingPolicy(SchedulePolicy):
         memory["result"] = result
         memory["fallback"] = result.delay is None
         if result.delay is None:
-            return self._fallback(*memory["tasks"], cmap)
+            traj1, traj2 = memory["tasks"]
+            return self._fallback(traj1, traj2, cmap)
         return schedules.delay_schedule(cmap, result.delay)
 
 
@@ -168,7 +171,8 @@ class ExhaustiveDelayPolicy(SchedulePolicy):
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
         if self.swept:  # v1: the exact minimum on the environment's check, not on a map
-            delay = exact_delay.true_min_delay(*memory["tasks"], self.safety_margin)
+            traj1, traj2 = memory["tasks"]
+            delay = exact_delay.true_min_delay(traj1, traj2, self.safety_margin)
         else:
             delay = schedules.exhaustive_min_delay(cmap)
         return schedules.delay_schedule(cmap, cmap.n1 if delay is None else delay)

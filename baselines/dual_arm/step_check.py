@@ -120,9 +120,9 @@ class StepCheck:
             self.state[rows, cols] = self.screen_entries(rows, cols)
             return
         keys = zip((rows[unknown] // TILE).tolist(), (cols[unknown] // TILE).tolist(), strict=True)
-        tiles = np.array(sorted(set(keys)), dtype=np.int64)  # (n, 2)
+        found = np.array(sorted(set(keys)), dtype=np.int64)  # (n, 2): the tiles
         offsets = np.indices((TILE, TILE)).reshape(2, -1).T  # (TILE^2, 2)
-        idx = (tiles[:, None, :] * TILE + offsets[None]).reshape(-1, 2)
+        idx = (found[:, None, :] * TILE + offsets[None]).reshape(-1, 2)
         idx = idx[(idx[:, 0] <= self.n1) & (idx[:, 1] <= self.n2 + 1)]
         idx = idx[self.state[idx[:, 0], idx[:, 1]] == UNKNOWN]
         self.state[idx[:, 0], idx[:, 1]] = self.screen_entries(idx[:, 0], idx[:, 1])

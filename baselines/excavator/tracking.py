@@ -127,4 +127,5 @@ def solve_pose(
                 return result
             if best is None or result.position_error < best.position_error:
                 best = result
+    assert best is not None, "q_rest and q_ready always give starts"
     return best

@@ -249,7 +249,7 @@ def sweep_cost(along: int, across: int, w: int) -> int:
     return -(-across // w) * max(along - w, 0) + max(across - w, 0)
 
 
-def restart_heading(stretch: tuple[int, int, int, int], heading: int, side: int, w: int):
+def restart_heading(stretch: tuple[int, ...], heading: int, side: int, w: int):
     """The heading and shift side a run restarted at a popped point sweeps with.
 
     ``stretch[k]``: configurations covering unswept cells met in a row from

@@ -54,7 +54,10 @@ def turn_towards(heading: int, target: int) -> int:
 def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:
     """``(w, R)``: the robot width (from the env's keywords) and sensing range (window size)."""
     w = SweeperParams.from_kwargs(env_kwargs).robot_width
-    s = int(round(np.sqrt(observation_space["sensed"].shape[0])))
+    sensed = observation_space["sensed"] if isinstance(observation_space, spaces.Dict) else None
+    if not isinstance(sensed, spaces.Box):
+        raise ValueError(f"observation_space must be the sweeper's, got {observation_space}")
+    s = int(round(np.sqrt(sensed.shape[0])))
     return w, (s - w) // 2
 
 
@@ -191,6 +194,7 @@ class PsaCwaPolicy(ScriptedPolicy):
 
     # -------------------------------------------------------------- PSA modes
     def _lane(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        assert m.run_heading is not None and m.run_side is not None, "set before a lane"
         if h != m.run_heading:
             return turn_towards(h, m.run_heading)
         nr, nc = r + int(DR[h]), c + int(DC[h])
@@ -198,6 +202,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         edge = occupancy.entering_mask(int(DR[h]), int(DC[h]), self.w)
         if psa.lane_open(occ, sw[edge]):
             return FORWARD  # step 1: straight on, sweeping
+        assert m.lane_start is not None, "set before a lane"
         for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
             if self._strip_unswept(m, seg):
                 m.stack.push(seg, m.run)
@@ -228,6 +233,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         """Step 4 towards side ``s``: ``(j, base, k)``, a shift of ``k`` cells from ``j``
         cells back along the lane, or None when no shift leads to a lane with work."""
         back = (h + 2) % 4
+        assert m.lane_start is not None, "set before a lane"
         lane_len = abs(r - m.lane_start[0]) + abs(c - m.lane_start[1])
         plan = None
         for j in range(0, lane_len + 1 if self.slide_back else 1):  # pragma: no branch
@@ -285,6 +291,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         over configurations known to be free, and is pushed when it holds
         unswept cells (steps 2-3 for the cells no side segment covers).
         """
+        assert m.run_heading is not None and m.run_side is not None, "set with the run"
         seg = psa.behind_segment((r, c), m.run_heading, m.lane_length, m.run_side)
         rr, cc = psa.segment_configs(seg)
         known = 0
@@ -321,6 +328,7 @@ class PsaCwaPolicy(ScriptedPolicy):
             return None
 
         retry, m.retry = m.retry, False
+        group: list[int] | range
         while len(m.stack):
             if retry:  # the entry of an aborted transfer, re-pushed on top
                 group, retry = [len(m.stack) - 1], False
@@ -355,6 +363,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         return None
 
     def _transfer(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        assert m.goal is not None, "set with the transfer"
         if (r, c) != m.goal:  # the path was blocked: plan again
             origin, occ, swept, cfree, cur = self._known(m, r, c)
             goal = (m.goal[0] - origin[0], m.goal[1] - origin[1])
@@ -366,13 +375,14 @@ class PsaCwaPolicy(ScriptedPolicy):
             m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
             return None
         if self.restart_axis:
+            assert m.run_heading is not None and m.run_side is not None, "set with the transfer"
             m.run_heading, m.run_side = psa.restart_heading(
                 self._stretches(m, r, c), m.run_heading, m.run_side, self.w
             )
         m.mode, m.lane_start, m.first_lane = "lane", (r, c), True
         return None
 
-    def _stretches(self, m: Memory, r: int, c: int) -> tuple[int, int, int, int]:
+    def _stretches(self, m: Memory, r: int, c: int) -> tuple[int, ...]:  # 4 values
         """Per heading: known-map configurations covering unswept cells in a row from ``(r, c)``."""
         _, occ, swept, cfree, cur = self._known(m, r, c)
         return psa.stretches(psa.covers_unswept(occ, swept, self.w) & cfree, cur)
@@ -400,7 +410,8 @@ class PsaCwaPolicy(ScriptedPolicy):
         m.cwa_last, m.stalls = state, 0
         wide = (occupancy.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
         if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
-            return self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
+            self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
+            return None
         m.cwa_stack = [
             ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
             for s, cells in cwa.scan_groups(targets, occ == OBSTACLE, self.w)
@@ -423,6 +434,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         heading = max(range(4), key=lambda k: stretch[k])
         side = max((psa.left_of(heading), psa.right_of(heading)), key=lambda k: stretch[k])
         path = self._plan(occ, swept, cfree, cur, target)
+        assert path is not None, "the target is reachable (it lies in cfree's region)"
         m.path = deque((p[0] + origin[0], p[1] + origin[1]) for p in path)
         m.goal = (target[0] + origin[0], target[1] + origin[1])
         m.run_heading, m.run_side, m.mode = heading, side, "transfer"
@@ -473,6 +485,7 @@ class PsaCwaPolicy(ScriptedPolicy):
         return None
 
     def _cwa_follow(self, m: Memory, r: int, c: int, h: int) -> int | None:
+        assert m.cwa_cells is not None, "set before following"
         cells = self._remaining(m, m.cwa_cells)
         m.cwa_cells = cells
         if not len(cells):

@@ -70,8 +70,9 @@ def _end_point_plan() -> dict[int, list[tuple[int, int, str, tuple[float, float,
     plan: dict[int, list] = {}
     for i, body in enumerate(model.CHECKED):
         inv = np.linalg.inv(model._LINK[body - 1])
+        ends = model.LINKS[body - 1][:2]  # (a, b): the row without its radius
         for end in range(2):
-            in_b = tuple(float(v) for v in model.LINKS[body - 1][end])
+            in_b = tuple(float(v) for v in ends[end])
             in_f = tuple(_snap(float(v)) for v in (inv @ np.array([*in_b, 1.0]))[:3])
             nonzero_b, nonzero_f = sum(v != 0 for v in in_b), sum(v != 0 for v in in_f)
             frame, coords = ("B", in_b) if nonzero_b <= nonzero_f else ("F", in_f)
@@ -92,10 +93,11 @@ def _terms(coefs: tuple[float, ...]) -> tuple[tuple[int, float], ...]:
 
 def _sum(terms: tuple[tuple[int, float], ...], arrays: tuple) -> np.ndarray:
     """``sum c * arrays[i]`` over ``terms`` (unit coefficients without a product)."""
-    out = None
+    out: np.ndarray | None = None
     for i, c in terms:
         term = arrays[i] if c == 1.0 else -arrays[i] if c == -1.0 else c * arrays[i]
         out = term if out is None else out + term
+    assert out is not None, "no non-zero term"
     return out
 
 

@@ -16,9 +16,15 @@ infinite). The world's ``reset`` sets the fixed bounds these methods read
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any
 
 from motiongym.envs.excavator import bodies
 from motiongym.envs.excavator.world import HORIZON
+
+if TYPE_CHECKING:
+    from motiongym.envs.excavator.config import Machine
+    from motiongym.envs.excavator.obstacles import Pipe, Truck
+    from motiongym.envs.excavator.world_v1 import Pose
 
 SELF_HORIZON = 0.3  # m: self clearance exact below this
 UNDER_REACH = 1.3  # m: how far any body (bucket box: 1.12 m) reaches from the arm's polyline
@@ -30,6 +36,33 @@ SKIP = bodies.SKIP  # m: a bound this far above the smallest clearance so far le
 
 class ClearancesV1:
     """Mixin of :class:`.world_v1.ExcavatorWorldV1`: the clearances (module docstring)."""
+
+    # What the mixin reads of the world (set by its reset and step; declarations only).
+    m: Machine
+    pipe: Pipe
+    truck: Truck
+    q: list[Any]
+    points: tuple[tuple[float, float, float], ...]
+    rotation: Any  # 3 x 3 rows (frame M to O), None on level ground
+    _pose_now: Pose
+    _pipe_body: bodies.Capsule
+    _pipe_top: float  # m
+    _pipe_line3: tuple[bodies.Vec, bodies.Vec, float]  # a, b - a, 1 / |b - a|^2
+    _truck_body: bodies.Box
+    _truck_centre: tuple[float, float]  # m, plan view
+    _truck_radius: float  # m
+    _truck_height: float  # m, the truck bed's top
+    _axis: tuple[float, float]  # m, the swing axis in plan view
+    _house_truck: float  # m, the house's fixed lower bound to the truck
+    _house_top: float  # m
+    _house_mid: bodies.Vec
+    _house_radius: float  # m
+    _bucket_sphere: tuple[float, float, float]  # along, back, radius (m)
+    _bucket_slack: float  # m
+    _sphere_slack: dict[str, float]  # m, per part
+    _swing_axis: bodies.Vec
+    _up: bodies.Vec
+    _tracks_box: Any  # the tracks' body (bodies.machine_bodies)
 
     def _clearances(self) -> None:
         """Exact body distances below the horizons, lower bounds above.

@@ -138,7 +138,8 @@ class ExcavatorBase(NeedsReset, Renders, gym.Env):
         The static fields (task, truck, pipe, base) are written once at reset.
         """
         w, buf = self.world, self._obs
-        _STATE.pack_into(buf, 0, *w.q, *w.qdot, *w.tip, w.beta, w.fill)
+        # numpy declares the buffer protocol (__buffer__) to type checkers for Python >= 3.12 only
+        _STATE.pack_into(buf, 0, *w.q, *w.qdot, *w.tip, w.beta, w.fill)  # type: ignore[arg-type]
         buf[self._profile] = w.profile()
         self.task.write(w, buf)
         return buf.copy()

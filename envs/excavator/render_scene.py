@@ -6,7 +6,8 @@ into a body placed at ``RotX(alpha_{i-1}) TransX(a_{i-1}) TransZ(d_i)`` with a
 hinge about its local z axis, so MuJoCo's kinematics is the paper's (tested:
 the ``tip`` site equals :func:`kinematics.forward` at random joint angles).
 The world adds the height-field ground, the pipe, the truck body, the dig
-zone and the target marker. MuJoCo is used for rendering and for that
+zone and the target marker (a glowing sphere; the pipe glows through the see-through
+ground). MuJoCo is used for rendering and for that
 cross-check; an environment step uses the NumPy/scalar kinematics.
 """
 
@@ -79,6 +80,13 @@ def build_spec(m: Machine, with_world: bool = True) -> mujoco.MjSpec:
     return spec
 
 
+def _glowing(spec: mujoco.MjSpec, name: str, emission: float) -> str:
+    """A material that glows by ``emission`` (geom colours stay the geoms')."""
+    material = spec.add_material(name=name)
+    material.emission = emission
+    return name
+
+
 def _add_world(spec: mujoco.MjSpec, m: Machine) -> None:
     world = spec.worldbody
     nx, ny = GRID_SHAPE
@@ -88,17 +96,22 @@ def _add_world(spec: mujoco.MjSpec, m: Machine) -> None:
     field.userdata = list(np.full(nx * ny, -Z_MIN / (Z_MAX - Z_MIN)))
     ground = world.add_geom(name="ground", type=mujoco.mjtGeom.mjGEOM_HFIELD, hfieldname="ground")
     ground.pos = [GRID_ORIGIN[0] + nx * GRID_CELL / 2, GRID_ORIGIN[1] + ny * GRID_CELL / 2, Z_MIN]
-    ground.rgba = (0.6, 0.47, 0.32, 0.85)  # a little see-through: the pipe shows
+    ground.rgba = (0.6, 0.47, 0.32, 0.5)  # see-through: the buried pipe shows
     pipe = world.add_geom(name="pipe", type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[0.15, 0, 0])
-    pipe.fromto, pipe.rgba = [0, 0, -2, 1, 0, -2], (0.1, 0.4, 0.9, 1)
+    pipe.fromto, pipe.rgba = [0, 0, -2, 1, 0, -2], (0.1, 0.5, 1.0, 1)
+    pipe.material = _glowing(spec, "pipe_glow", 1.0)  # lit from within: seen through soil
     truck = world.add_geom(name="truck", type=mujoco.mjtGeom.mjGEOM_BOX, size=[2.5, 1.2, 1.4])
     truck.rgba = (0.8, 0.15, 0.1, 0.55)
     load = world.add_geom(name="truck_soil", type=mujoco.mjtGeom.mjGEOM_BOX, size=[2.4, 1.1, 0.01])
     load.rgba = (0.45, 0.3, 0.15, 1)
     zone = world.add_geom(name="zone", type=mujoco.mjtGeom.mjGEOM_BOX, size=[1, 0.6, 0.01])
     zone.rgba = (1.0, 1.0, 1.0, 0.6)
-    world.add_site(name="target", pos=[0, 0, -10], size=[0.15, 0, 0], rgba=[0.1, 0.9, 0.2, 0.8])
-    for geom in (ground, pipe, truck, load, zone):
+    # The reach target (m): drawn larger than the tip's 0.1 m tolerance so it shows at the
+    # camera's 24 m; glowing green, whatever the light.
+    target = world.add_geom(name="target", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.35, 0, 0])
+    target.pos, target.rgba = [0, 0, -10], (0.1, 1.0, 0.2, 1)
+    target.material = _glowing(spec, "target_glow", 0.8)
+    for geom in (ground, pipe, truck, load, zone, target):
         geom.contype, geom.conaffinity = 0, 0
 
 
@@ -171,8 +184,7 @@ class SceneRenderer:
         else:
             model.geom_pos[g] = [0, 0, -10]
         target = getattr(world.scene, "target", None)
-        if target is not None:
-            model.site_pos[model.site("target").id] = target[:3]
+        model.geom_pos[self._geom("target")] = [0, 0, -10] if target is None else target[:3]
         self._place_base(getattr(world, "rotation", None))
         mujoco.mj_kinematics(model, data)
         self.renderer.update_scene(data, self.camera)

@@ -227,7 +227,8 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
     iy = lambda y: min(max(int((y - GRID_ORIGIN[1]) / GRID_CELL), 0), GRID_SHAPE[1] - 1)  # noqa: E731
     for _ in range(10_000):
         q = rng.uniform(lo, hi)
-        pts = arm_points(*q.tolist(), m)  # Python floats: the same doubles, cheaper
+        q1, q2, q3, q4 = q.tolist()  # Python floats: the same doubles, cheaper
+        pts = arm_points(q1, q2, q3, q4, m)
         tip = pts[-1] if level else tuple(rotation @ pts[-1])
         ground = heights[ix(tip[0]), iy(tip[1])]
         if math.hypot(tip[0], tip[1]) < 4.0 or not 0.0 <= tip[2] - ground <= 2.5:

@@ -30,6 +30,8 @@ class ReachTask:
     CARVE = False
     REWARD_TERMS = ReachParams.REWARD_TERMS
 
+    _errors: tuple[Any, Any, Any]  # (tip, beta, (pos, ang)) of the last errors() call
+
     def __init__(self, params: ReachParams, layout) -> None:
         self.p = params
         self.w = params.weights
@@ -58,14 +60,15 @@ class ReachTask:
         buf[self.layout["target"]] = world.scene.target
         # The target as Python floats (the same doubles; NumPy scalars cost more per operation).
         self._target = tuple(float(x) for x in world.scene.target)
-        self._errors: tuple = (None, None, None)
+        self._errors = (None, None, None)
         pos, ang = self.errors(world)
         self._err = pos + ang
 
     def write(self, world, buf: np.ndarray) -> None:
         t, tip = self._target, world.tip
+        # numpy declares the buffer protocol (__buffer__) to type checkers for Python >= 3.12 only
         _ERROR.pack_into(
-            buf,
+            buf,  # type: ignore[arg-type]
             self._error_offset,
             t[0] - tip[0],
             t[1] - tip[1],

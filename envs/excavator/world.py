@@ -156,7 +156,8 @@ class ExcavatorWorld:
 
     # --------------------------------------------------------------- physics
     def _forward(self) -> None:
-        self.points = arm_points(*self.q, self.m)
+        q1, q2, q3, q4 = self.q
+        self.points = arm_points(q1, q2, q3, q4, self.m)
         self.tip = self.points[3]
         self.beta = self.q[1] + self.q[2] + self.q[3]
 

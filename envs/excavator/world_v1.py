@@ -58,7 +58,7 @@ from motiongym.envs.excavator.scenes import (
     GRID_SHAPE,
     ground_plane,
 )
-from motiongym.envs.excavator.soil import cutting_force
+from motiongym.envs.excavator.soil import Terrain, cutting_force
 from motiongym.envs.excavator.world import POUR_NZ, POUR_TIME, ExcavatorWorld
 
 BISECTIONS = 6
@@ -94,7 +94,8 @@ class Pose:
     def __init__(self, q, world) -> None:
         self.q, self._world = q, world
         # (terrain, its version, depth): the exact depths below, kept while the ground stays.
-        self.edge_memo = self.body_memo = (None, -1, 0.0)
+        self.edge_memo: tuple[Terrain | None, int, float] = (None, -1, 0.0)
+        self.body_memo: tuple[Terrain | None, int, float] = (None, -1, 0.0)
         # arm_points (eq. 4, scalar form) written out with the same arithmetic; the
         # bucket's angle beta = q2 + q3 + q4 is its last joint sum (cos, sin shared).
         L0, L1, d1, d2, L2, L3, L4 = world._links
@@ -249,8 +250,8 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         # The bucket's box (bodies.bucket_box): -0.15 to L4 + 0.05 along u, -0.05 to
         # BUCKET_BACK behind the opening; its bounding sphere about the box's centre.
         along, back = 0.5 * (m.L4 - 0.1), 0.5 * (bodies.BUCKET_BACK - 0.05)
-        half = (0.5 * (m.L4 + 0.2), back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
-        self._bucket_sphere = along, back, math.sqrt(sum(h * h for h in half))
+        box_half = (0.5 * (m.L4 + 0.2), back + 0.05, 0.5 * m.bucket_width + bodies.BUCKET_SIDE)
+        self._bucket_sphere = along, back, math.sqrt(sum(h * h for h in box_half))
         self._bucket_slack = 1e-9  # rounding: the sphere contains the box
         self._sphere_slack = {"bucket": self._bucket_slack, "house": 0.0}
         self._swing_axis, self._up = bodies.swing_axis(self.rotation, m.L0)

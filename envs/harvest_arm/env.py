@@ -161,8 +161,9 @@ class HarvestArmEnv(NeedsReset, Renders, gym.Env):
         width: int = 480,
         height: int = 360,
     ) -> None:
+        # dof, n_obstacles, n_bars: None is the variant's default, an int after __post_init__
         p = HarvestArmParams(
-            dof, planar, n_obstacles, n_bars, link_radius, dt, safety_distance,
+            dof, planar, n_obstacles, n_bars, link_radius, dt, safety_distance,  # type: ignore[arg-type]
             success_tolerance, terminate_on_collision, self_collision, progress, clearance,
             collision, effort, success, distance, width, height,
         )  # fmt: skip

@@ -97,8 +97,8 @@ def arm_spec(dof: int, planar: bool) -> ArmSpec:
             Joint(f"j{i + 1}", (length, 0.0, 0.0), _Z, _deg(150), 3.14) for i in range(1, dof)
         ]
         bend = -2.6 / (dof - 1)  # rad: an arm curled over the workspace, gripper pointing down
-        home = (1.8,) + (bend,) * (dof - 1)
-        return ArmSpec(f"planar{dof}", True, tuple(joints), (length, 0.0, 0.0), home)
+        curled = (1.8,) + (bend,) * (dof - 1)
+        return ArmSpec(f"planar{dof}", True, tuple(joints), (length, 0.0, 0.0), curled)
     if dof not in SPATIAL_DOFS:
         raise ValueError(f"spatial dof must be one of {SPATIAL_DOFS}, got {dof!r}")
     waist = Joint("waist", (0.0, 0.0, 0.0), _Z, _deg(175), 3.14)

@@ -145,8 +145,8 @@ class HarvestArmWorld:
             camera.lookat[:] = (0.35, -0.15, 0.0)
             camera.distance, camera.azimuth, camera.elevation = 1.7, 90.0, -90.0
         else:
-            camera.lookat[:] = (0.35, 0.0, 0.4)
-            camera.distance, camera.azimuth, camera.elevation = 1.7, 200.0, -20.0
+            camera.lookat[:] = (0.35, 0.0, 0.35)
+            camera.distance, camera.azimuth, camera.elevation = 1.15, 210.0, -25.0
         renderer.update_scene(self.data, camera=camera)
         scene = renderer.scene
         for p0, p1 in zip(path[:-1], path[1:], strict=False):

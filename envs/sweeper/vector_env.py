@@ -433,9 +433,12 @@ class SweeperVectorEnv(VectorEnv):
 
     def _info(self, idx: Any, terms: dict[str, Any], bump: np.ndarray) -> dict:
         counters = (self.n_swept, self.n_reach, self.n_over, self.travel, self.turns)
-        n_swept, n_reach, *rest = (a[idx] for a in (*counters, self.bumps, self.steps))
+        n_swept, n_reach, n_over, travel, turns, bumps, steps = (
+            a[idx] for a in (*counters, self.bumps, self.steps)
+        )
         success = task.is_success(n_swept, n_reach)
-        info = batch_info(success, bump, terms, **measures(n_swept, n_reach, *rest, self.w))
+        done = measures(n_swept, n_reach, n_over, travel, turns, bumps, steps, self.w)
+        info = batch_info(success, bump, terms, **done)
         mask = np.ones(len(info["coverage"]), bool)
         for key in INFO_KEYS:
             info[f"_{key}"] = mask.copy()
@@ -453,6 +456,7 @@ class SweeperVectorEnv(VectorEnv):
             raise RuntimeError("call reset() before state()")
         g, P = self._grids, self.R
         sc = self._scenarios[i]
+        assert sc is not None, "reset() sets every sub-environment's scenario"
         H, W = sc.obstacle.shape
         cell = g.cell[i].reshape(g.Hp, g.Wp)[: H + 2 * P, : W + 2 * P]
         r, c = int(self.r[i]), int(self.c[i])
@@ -485,7 +489,9 @@ class SweeperVectorEnv(VectorEnv):
             path=list(self._paths[i]),
         )
 
-    def render(self) -> tuple[np.ndarray, ...] | None:
+    # Gymnasium types the frames with a TypeVar bound to no class argument: no concrete
+    # return type matches it.
+    def render(self) -> tuple[np.ndarray, ...] | None:  # type: ignore[override]
         if self.render_mode != "rgb_array" or not self._ready:
             return None
         px = self.params.cell_pixels

@@ -20,6 +20,14 @@ ppo:
 """
 
 
+@pytest.fixture
+def tiny_config(tmp_path):
+    """``TINY_CONFIG`` in a file: one PPO update of 64 steps."""
+    path = tmp_path / "tiny.yml"
+    path.write_text(TINY_CONFIG)
+    return path
+
+
 @pytest.fixture(scope="session")
 def shipped_folder(tmp_path_factory):
     root = tmp_path_factory.mktemp("ship")

@@ -118,3 +118,16 @@ def test_zoo_blocks_convert_our_names():
     assert options == ["--env-kwargs distance:1.0", "--eval-freq 500"]
     assert refusal({"vec_env": "pettingzoo"}) and refusal({"residual": "dig-cycle"})
     assert refusal({"deterministic": False}) and refusal({}) is None
+
+
+def test_a_zoo_model_whose_rate_is_a_schedule_object_loads(tmp_path, env):
+    """rl-zoo3 saves the learning rate as SB3's ConstantSchedule, a pickled entry whose plain
+    ``val`` stands beside it: it is read from there (before: 'would run code; refused')."""
+    from stable_baselines3.common.utils import ConstantSchedule
+
+    path = tmp_path / "zoo.zip"
+    PPO("MlpPolicy", env, n_steps=64, learning_rate=ConstantSchedule(3e-4), device="cpu").save(path)
+    model = load_predictor(str(path), ENV_ID, env, trust=True)
+    assert model.learning_rate(1.0) == 3e-4
+    action, _ = model.predict(env.reset(seed=0)[0], deterministic=True)
+    assert env.action_space.contains(action)
