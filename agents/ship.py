@@ -27,10 +27,20 @@ from motiongym.agents.pretrained import (
 )
 
 
+def agent_kind(config: dict) -> str:
+    """How a run's agent learned: ``demonstrations`` (``imitate`` or ``demonstrations``),
+    ``residual`` (acts through a scripted policy), else ``scratch``."""
+    if config.get("imitate") or config.get("demonstrations"):
+        return "demonstrations"
+    return "residual" if config.get("residual") else "scratch"
+
+
 def shipped_label(config: dict) -> str:
     """The folder name of a run's model under its ID: the algorithm, ``-shared`` for a
-    shared-parameter multi-agent run (``vec_env: pettingzoo``)."""
-    return config["algo"] + ("-shared" if config.get("vec_env") == "pettingzoo" else "")
+    shared-parameter multi-agent run (``vec_env: pettingzoo``), ``-dagger`` for one taught
+    by DAgger (``imitate``), so that each kind ships beside the others."""
+    label = config["algo"] + ("-shared" if config.get("vec_env") == "pettingzoo" else "")
+    return label + ("-dagger" if config.get("imitate") else "")
 
 
 def _run_config(run_dir: Path) -> dict:
@@ -166,6 +176,7 @@ def ship(
     metrics = {
         "env_id": env_id,
         "policy": label,
+        "kind": agent_kind(configs[best]),
         "shipped_run": runs[best]["run"],
         "held_out_seeds": list(seeds),
         "pooled": pooled.summary(),
