@@ -85,6 +85,42 @@ def _rollout(
     return observations, labels, guesses, bool(info.get("is_success", False))
 
 
+def _learner(model: BaseAlgorithm, env: gym.Env, normalization: VecNormalize | None):
+    """The model's deterministic action for one raw observation, within the action box."""
+    if not isinstance(env.action_space, gym.spaces.Box):
+        raise ValueError(f"env must have a Box action space, got {env.action_space}")
+    low, high = env.action_space.low, env.action_space.high
+
+    def act(observation: Any) -> np.ndarray:
+        if normalization is not None:
+            observation = normalization.normalize_obs(observation)
+        action, _ = model.predict(observation, deterministic=True)
+        return np.clip(action, low, high)
+
+    return act
+
+
+def on_policy_error(
+    model: BaseAlgorithm,
+    env: gym.Env,
+    teacher: Any,
+    seeds: range,
+    normalization: VecNormalize | None = None,
+) -> tuple[float, float]:
+    """``(mean squared error to the teacher on the learner's own states, success rate)``.
+
+    DAgger's measure (Ross et al.'s expected loss under the learner's state
+    distribution): the learner acts on episodes ``seeds``, the teacher labels.
+    """
+    act = _learner(model, env, normalization)
+    errors, successes = [], []
+    for seed in seeds:
+        _, labels, guesses, success = _rollout(env, teacher, act, seed)
+        errors.append(np.mean((np.asarray(guesses) - np.asarray(labels)) ** 2, axis=1))
+        successes.append(success)
+    return float(np.mean(np.concatenate(errors))), float(np.mean(successes))
+
+
 def dagger(
     model: BaseAlgorithm,
     env: gym.Env,
@@ -112,14 +148,8 @@ def dagger(
     """
     check_int("iterations", iterations, 0, 10_000)
     check_int("episodes", episodes, 1, 10**6)
-    if not isinstance(env.action_space, gym.spaces.Box):
-        raise ValueError(f"env must have a Box action space, got {env.action_space}")
-    low, high = env.action_space.low, env.action_space.high
+    learner = _learner(model, env, normalization)
     normalize = normalization.normalize_obs if normalization is not None else (lambda o: o)
-
-    def learner(observation: Any) -> np.ndarray:
-        action, _ = model.predict(normalize(observation), deterministic=True)
-        return np.clip(action, low, high)
 
     observations: list[Any] = []
     labels: list[np.ndarray] = []
