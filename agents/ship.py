@@ -55,6 +55,14 @@ def _run_config(run_dir: Path) -> dict:
     return config
 
 
+def _imitation_seconds(run_dir: Path) -> dict[str, float]:
+    """``{"dagger_seconds": s}``: the wall-clock time of a run's DAgger (none without)."""
+    file = run_dir / "dagger.json"
+    if not file.is_file():
+        return {}
+    return {"dagger_seconds": float(json.loads(file.read_text())["seconds"])}
+
+
 def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:
     """``seed,steps,mean return,success rate`` per evaluation of the run's callback."""
     file = run_dir / "eval" / "evaluations.npz"
@@ -153,6 +161,7 @@ def ship(
                 "run": run_dir.name,
                 "training_seed": config["seed"],
                 "deterministic": config.get("deterministic", True),
+                **_imitation_seconds(run_dir),
                 **evaluation.to_json(),
             }
         )
