@@ -53,6 +53,8 @@ imitate        a scripted policy's name: DAgger                      null
                before RL, the teacher queried on the learner's own
                states; normalisation statistics: the teacher's
                states, frozen. With ``n_timesteps: 0`` no RL follows
+imitate_kwargs the teacher's own keywords (mapping), e.g.              {}
+               ``track_progress: true`` for the dual-arm schedules
 dagger_iterations learner-acting DAgger iterations after the          4
                teacher's (0: plain behaviour cloning)
 dagger_episodes episodes rolled out per DAgger iteration             50
@@ -97,6 +99,7 @@ RUN_SETTINGS: dict[str, Any] = {
     "demonstrations": None,
     "bc_epochs": 20,
     "imitate": None,
+    "imitate_kwargs": {},
     "dagger_iterations": 4,
     "dagger_episodes": 50,
 }
@@ -288,6 +291,8 @@ def _check_imitation(config: dict[str, Any]) -> None:
         raise ArgumentError(f"imitate must be a scripted policy's name, got {name!r}")
     if name is not None and (config["demonstrations"] or config["residual"]):
         raise ArgumentError("imitate cannot be combined with demonstrations or residual")
+    if not isinstance(config["imitate_kwargs"], dict):
+        raise ArgumentError(f"imitate_kwargs must be a mapping, got {config['imitate_kwargs']!r}")
     check_int("dagger_iterations", config["dagger_iterations"], 0, 10_000)
     check_int("dagger_episodes", config["dagger_episodes"], 1, 10**6)
     if config["n_timesteps"] == 0 and not (name or config["demonstrations"]):

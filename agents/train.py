@@ -179,9 +179,17 @@ def _imitate(env_id: str, config: dict[str, Any], model, venv, seed: int, run_di
     from motiongym.baselines import make_policy
 
     env = gym.make(env_id, **config["env_kwargs"])
-    teacher = make_policy(
-        env_id, config["imitate"], env.observation_space, env.action_space, env.spec.kwargs
-    )
+    try:
+        teacher = make_policy(
+            env_id,
+            config["imitate"],
+            env.observation_space,
+            env.action_space,
+            env.spec.kwargs,
+            **config["imitate_kwargs"],
+        )
+    except (TypeError, ValueError) as error:  # a keyword the teacher lacks, or a bad value
+        raise UsageError(f"imitate_kwargs for {config['imitate']!r}: {error}") from None
     started = time.perf_counter()
     history = dagger(
         model,
