@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import numpy as np
 import torch
 from gymnasium import spaces
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
@@ -153,31 +152,6 @@ class SweeperEgocentric(BaseFeaturesExtractor):
 
 
 # Names a config may give ``features_extractor_class`` -> the class.
-class DropInputs(BaseFeaturesExtractor):
-    """A flat Box observation without the entries ``drop`` (indices), for a learner that
-    must not see them.
-
-    The imitation learner's guard against *causal confusion* (de Haan, Jayaraman and
-    Levine 2019): where an input nearly equals the teacher's previous action (the
-    excavator's joint rates, which its acceleration-limited tracking changes by at most
-    ``accel_max dt`` per step), cloning learns to repeat it, and a learner at rest stays
-    at rest. Output: the remaining entries, in order (``features_dim`` = their count).
-    """
-
-    def __init__(self, observation_space: spaces.Box, drop: Sequence[int] = ()) -> None:
-        size = int(np.prod(observation_space.shape))
-        dropped = {int(i) for i in drop}
-        if not dropped <= set(range(size)):
-            raise ValueError(f"drop must hold indices in [0, {size}), got {sorted(dropped)}")
-        keep = [i for i in range(size) if i not in dropped]
-        super().__init__(observation_space, len(keep))
-        self.register_buffer("keep", torch.tensor(keep, dtype=torch.long), persistent=False)
-
-    def forward(self, observations: torch.Tensor) -> torch.Tensor:
-        return observations.flatten(1)[:, self.keep]
-
-
 FEATURES_EXTRACTORS: dict[str, type[BaseFeaturesExtractor]] = {
-    "drop_inputs": DropInputs,
-    "sweeper_egocentric": SweeperEgocentric,
+    "sweeper_egocentric": SweeperEgocentric
 }
