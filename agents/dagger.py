@@ -89,6 +89,11 @@ def _learner(model: BaseAlgorithm, env: gym.Env, normalization: VecNormalize | N
     """The model's deterministic action for one raw observation, within the action box."""
     if not isinstance(env.action_space, gym.spaces.Box):
         raise ValueError(f"env must have a Box action space, got {env.action_space}")
+    if not isinstance(env.observation_space, gym.spaces.Box):  # the aggregate is one array
+        raise ValueError(
+            f"env must have a Box observation space (the non-goal IDs), got "
+            f"{type(env.observation_space).__name__}"
+        )
     low, high = env.action_space.low, env.action_space.high
 
     def act(observation: Any) -> np.ndarray:

@@ -124,6 +124,8 @@ def test_dagger_refuses_a_discrete_action_space():
     env = gym.make("motiongym/Sweeper-v1")
     with pytest.raises(ValueError, match="env must have a Box action space, got Discrete"):
         dagger(None, env, None)
+    with pytest.raises(ValueError, match="Box observation space .the non-goal IDs., got Dict"):
+        dagger(None, gym.make("motiongym/HarvestArmGoal-v1"), None)
     with pytest.raises(ValueError, match="iterations"):
         dagger(None, gym.make(REACH), None, iterations=-1)
 
