@@ -75,6 +75,8 @@ lint: $(STAMP)
 # and the dual-arm shared-parameter block, three training seeds each; `ship`
 # evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
 SEEDS ?= 0 1 2
+# Agents from demonstrations (DAgger, configs/<ID>-dagger.yml), shipped as sac-dagger.
+DAGGER_IDS ?= ExcavatorReach-v1 DualArmCell-v1
 IDS ?= Sweeper-v0 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
 # Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
 # as <algo>-residual.
@@ -97,6 +99,13 @@ models: $(STAMP)
 	      --config configs/$$id-residual.yml --out runs/models-residual || exit 1; \
 	  done; \
 	  $(BIN)/motiongym ship runs/models-residual/$$id/*_seed* --episodes 50 || exit 1; \
+	done
+	for id in $(DAGGER_IDS); do \
+	  for seed in $(SEEDS); do \
+	    $(BIN)/motiongym train motiongym/$$id --seed $$seed \
+	      --config configs/$$id-dagger.yml --out runs/models-dagger || exit 1; \
+	  done; \
+	  $(BIN)/motiongym ship --episodes 100 runs/models-dagger/$$id/sac_seed* || exit 1; \
 	done
 
 # BENCHMARKS.md's tables and figures, from the shipped models' metrics.

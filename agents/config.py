@@ -46,7 +46,18 @@ demonstrations a Minari dataset folder (``motiongym dataset``): the   null
                policy is behaviour-cloned on it
                (:mod:`motiongym.agents.imitation`) before RL;
                normalisation statistics: the demonstrations', frozen
-bc_epochs      epochs of that behaviour cloning                      20
+bc_epochs      epochs of that behaviour cloning (and of each DAgger   20
+               refit)
+imitate        a scripted policy's name: DAgger                      null
+               (:mod:`motiongym.agents.dagger`) teaches the policy
+               before RL, the teacher queried on the learner's own
+               states; normalisation statistics: the teacher's
+               states, frozen. With ``n_timesteps: 0`` no RL follows
+imitate_kwargs the teacher's own keywords (mapping), e.g.              {}
+               ``track_progress: true`` for the dual-arm schedules
+dagger_iterations learner-acting DAgger iterations after the          4
+               teacher's (0: plain behaviour cloning)
+dagger_episodes episodes rolled out per DAgger iteration             50
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its
@@ -87,6 +98,10 @@ RUN_SETTINGS: dict[str, Any] = {
     "residual_scale": 1.0,
     "demonstrations": None,
     "bc_epochs": 20,
+    "imitate": None,
+    "imitate_kwargs": {},
+    "dagger_iterations": 4,
+    "dagger_episodes": 50,
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
@@ -193,7 +208,7 @@ def validate_block(block: Any, algo: str, where: str) -> dict[str, Any]:
 # upper bounds keep a run's memory and time finite (a 10**12-step rollout buffer).
 _INT_RANGES: dict[str, tuple[int, int | None]] = {
     "n_envs": (1, 1024),
-    "n_timesteps": (1, 10**11),
+    "n_timesteps": (0, 10**11),  # 0: imitation only (``imitate`` or ``demonstrations``)
     "eval_freq": (1, 10**11),
     "n_eval_episodes": (1, 100_000),
     "checkpoint_freq": (1, 10**11),
@@ -264,8 +279,24 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
             f"demonstrations must be a dataset folder, got {config['demonstrations']!r}"
         )
     check_int("bc_epochs", config["bc_epochs"], 1, 100_000)
+    _check_imitation(config)
     if "log_std_init" in config["policy_kwargs"]:
         check_float("log_std_init", config["policy_kwargs"]["log_std_init"], -20.0, 20.0)
+
+
+def _check_imitation(config: dict[str, Any]) -> None:
+    """``imitate`` a name, not with ``demonstrations`` nor ``residual``; 0 steps only with one."""
+    name = config["imitate"]
+    if name is not None and not isinstance(name, str):
+        raise ArgumentError(f"imitate must be a scripted policy's name, got {name!r}")
+    if name is not None and (config["demonstrations"] or config["residual"]):
+        raise ArgumentError("imitate cannot be combined with demonstrations or residual")
+    if not isinstance(config["imitate_kwargs"], dict):
+        raise ArgumentError(f"imitate_kwargs must be a mapping, got {config['imitate_kwargs']!r}")
+    check_int("dagger_iterations", config["dagger_iterations"], 0, 10_000)
+    check_int("dagger_episodes", config["dagger_episodes"], 1, 10**6)
+    if config["n_timesteps"] == 0 and not (name or config["demonstrations"]):
+        raise ArgumentError("n_timesteps 0 (no RL) needs imitate or demonstrations")
 
 
 def _check_replay_buffer(config: dict[str, Any]) -> None:

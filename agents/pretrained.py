@@ -1,8 +1,11 @@
 """The trained models shipped in ``agents/pretrained/``.
 
-Layout: ``pretrained/<Name>-vN/<algo>/`` holds a run folder's ``model.zip``,
-``config.yml``, ``command.txt``, ``metrics.json``, optionally
-``vecnormalize.npz``, and ``manifest.json``: the SHA-256 of every other file.
+Layout: ``pretrained/<Name>-vN/<label>/`` (the algorithm, with ``-shared`` or
+``-dagger`` for those kinds, :func:`motiongym.agents.ship.shipped_label`) holds a
+run folder's ``model.zip``, ``config.yml``, ``command.txt``, ``metrics.json``
+(with the agent's ``kind``: ``scratch``, ``demonstrations`` or ``residual``),
+optionally ``vecnormalize.npz`` and ``dagger.json``, and ``manifest.json``: the
+SHA-256 of every other file.
 The manifest is checked before a model is used. :mod:`motiongym.agents.ship`
 puts a run's model here.
 """
@@ -18,7 +21,7 @@ from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 
 MANIFEST = "manifest.json"
-SHIPPED_FILES = ("model.zip", "vecnormalize.npz", "config.yml", "command.txt")
+SHIPPED_FILES = ("model.zip", "vecnormalize.npz", "config.yml", "command.txt", "dagger.json")
 METRICS = "metrics.json"
 LEARNING_CURVES = "learning_curves.csv"
 

@@ -27,19 +27,23 @@ from motiongym.agents.pretrained import (
 )
 
 
+def agent_kind(config: dict) -> str:
+    """How a run's agent learned: ``demonstrations`` (``imitate`` or ``demonstrations``),
+    ``residual`` (acts through a scripted policy), else ``scratch``."""
+    if config.get("imitate") or config.get("demonstrations"):
+        return "demonstrations"
+    return "residual" if config.get("residual") else "scratch"
+
+
 def shipped_label(config: dict) -> str:
     """The folder name of a run's model under its ID: the algorithm, ``-shared`` for a
     shared-parameter multi-agent run (``vec_env: pettingzoo``), ``-residual`` for a
-    correction of a scripted policy (``residual: <policy>``)."""
-    if config.get("vec_env") == "pettingzoo":
-        return config["algo"] + "-shared"
-    return config["algo"] + ("-residual" if config.get("residual") else "")
-
-
-def agent_kind(config: dict) -> str:
-    """What a shipped agent is, for ``metrics.json``'s ``kind``: ``residual`` (it acts
-    through a scripted policy), else ``learned`` (it acts alone)."""
-    return "residual" if config.get("residual") else "learned"
+    correction of a scripted policy (``residual: <policy>``), ``-dagger`` for one taught
+    by DAgger (``imitate``), so that each kind ships beside the others."""
+    label = config["algo"] + ("-shared" if config.get("vec_env") == "pettingzoo" else "")
+    if config.get("residual"):
+        return label + "-residual"
+    return label + ("-dagger" if config.get("imitate") else "")
 
 
 def _run_config(run_dir: Path) -> dict:
@@ -52,6 +56,14 @@ def _run_config(run_dir: Path) -> dict:
     if isinstance(config.get("seed"), bool) or not isinstance(config.get("seed"), int):
         raise UsageError(f"{config_file}: 'seed' must be an integer, got {config.get('seed')!r}")
     return config
+
+
+def _imitation_seconds(run_dir: Path) -> dict[str, float]:
+    """``{"dagger_seconds": s}``: the wall-clock time of a run's DAgger (none without)."""
+    file = run_dir / "dagger.json"
+    if not file.is_file():
+        return {}
+    return {"dagger_seconds": float(json.loads(file.read_text())["seconds"])}
 
 
 def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:
@@ -152,6 +164,7 @@ def ship(
                 "run": run_dir.name,
                 "training_seed": config["seed"],
                 "deterministic": config.get("deterministic", True),
+                **_imitation_seconds(run_dir),
                 **evaluation.to_json(),
             }
         )

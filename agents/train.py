@@ -13,7 +13,11 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 * ``checkpoints/``, ``tb/`` (TensorBoard), ``monitor/`` (per-episode CSVs);
 * ``behaviour_cloning.json``: with ``demonstrations`` in the block, the
   mean loss of each cloning epoch (the policy is cloned before RL; with
-  normalisation, its statistics are the demonstrations', frozen for the run).
+  normalisation, its statistics are the demonstrations', frozen for the run);
+* ``dagger.json``: with ``imitate: <policy>`` in the block, each DAgger
+  iteration's figures (:mod:`motiongym.agents.dagger`: the policy is taught
+  by that scripted policy before RL, none with ``n_timesteps: 0``; with
+  normalisation, its statistics are the teacher's states', frozen).
 
 Seeds: training environment ``k`` is seeded ``seed + k``; the evaluation
 callback's environment ``seed + 10_000``. Evaluations use seeds from
@@ -169,8 +173,48 @@ def _clone(env_id: str, config: dict[str, Any], model, venv, seed: int, run_dir:
     (run_dir / "behaviour_cloning.json").write_text(json.dumps({"loss": losses}) + "\n")
 
 
+def _imitate(env_id: str, config: dict[str, Any], model, venv, seed: int, run_dir: Path) -> None:
+    """Teach ``model`` by DAgger with the block's ``imitate`` policy as the teacher."""
+    from motiongym.agents.dagger import dagger, history_json
+    from motiongym.baselines import make_policy
+
+    env = gym.make(env_id, **config["env_kwargs"])
+    try:
+        teacher = make_policy(
+            env_id,
+            config["imitate"],
+            env.observation_space,
+            env.action_space,
+            env.spec.kwargs,
+            **config["imitate_kwargs"],
+        )
+    except (TypeError, ValueError) as error:  # a keyword the teacher lacks, or a bad value
+        raise UsageError(f"imitate_kwargs for {config['imitate']!r}: {error}") from None
+    started = time.perf_counter()
+    history = dagger(
+        model,
+        env,
+        teacher,
+        iterations=config["dagger_iterations"],
+        episodes=config["dagger_episodes"],
+        epochs=config["bc_epochs"],
+        normalization=venv if isinstance(venv, VecNormalize) else None,
+        training_seed=seed,
+    )
+    env.close()
+    record = {"seconds": time.perf_counter() - started, "iterations": history_json(history)}
+    (run_dir / "dagger.json").write_text(json.dumps(record, indent=1) + "\n")
+
+
 def _check_residual(env_id: str, config: dict[str, Any], where: Path) -> None:
-    """A residual agent: a scripted policy of ``env_id``, in a dummy or subproc vec env."""
+    """A DAgger teacher (``imitate``) and a residual agent's policy: scripted policies of
+    ``env_id``; a residual agent in a dummy or subproc vec env."""
+    teacher = config["imitate"]
+    if teacher is not None and teacher not in scripted_policies(env_id):
+        choices = ", ".join(sorted(scripted_policies(env_id))) or "none"
+        raise UsageError(
+            f"{where}: imitate {teacher!r} is not a scripted policy of {env_id} ({choices})"
+        )
     name = config["residual"]
     if name is None:
         return
@@ -297,6 +341,8 @@ def train(
             zero_correction(model)
         if config["demonstrations"]:
             _clone(env_id, config, model, venv, seed, run_dir)
+        if config["imitate"]:
+            _imitate(env_id, config, model, venv, seed, run_dir)
         eval_dir = run_dir / "eval"
         if algo == "maskableppo":
             from sb3_contrib.common.maskable.callbacks import (
@@ -328,9 +374,12 @@ def train(
                 folder.rmdir()
         raise
     try:
-        model.learn(
-            total_timesteps=int(config["n_timesteps"]), callback=callbacks, progress_bar=progress
-        )
+        if config["n_timesteps"]:
+            model.learn(
+                total_timesteps=int(config["n_timesteps"]),
+                callback=callbacks,
+                progress_bar=progress,
+            )
     except (ValueError, RuntimeError, FloatingPointError) as error:  # diverged (NaN logits)
         problem = " ".join(str(error).split())[:200]
         raise UsageError(

@@ -32,8 +32,10 @@ def make_policy(
     observation_space: gym.Space,
     action_space: gym.Space,
     env_kwargs: dict[str, Any] | None = None,
+    **options: Any,
 ) -> ScriptedPolicy:
-    """Instantiate the scripted policy ``name`` declared for ``env_id``."""
+    """Instantiate the scripted policy ``name`` declared for ``env_id``; ``options`` go to
+    its constructor (its own keywords, e.g. ``track_progress`` of the dual-arm schedules)."""
     declared = scripted_policies(env_id)
     if name not in declared:
         choices = ", ".join(sorted(declared)) or "none"
@@ -42,6 +44,6 @@ def make_policy(
         )
     module_name, class_name = declared[name].split(":")
     cls = getattr(importlib.import_module(module_name), class_name)
-    policy = cls(observation_space, action_space, env_kwargs)
+    policy = cls(observation_space, action_space, env_kwargs, **options)
     policy.env_id = env_id
     return policy

@@ -1,0 +1,204 @@
+"""DAgger: a learner that acts alone, taught by a scripted policy on the states it visits.
+
+Plain behaviour cloning (:func:`motiongym.agents.imitation.behaviour_clone`)
+fits the teacher's actions on the teacher's own states; the learner's small
+errors then lead it to states the teacher never showed, where its errors
+compound (Ross, Gordon and Bagnell 2011, "A reduction of imitation learning
+and structured prediction to no-regret online learning", AISTATS: the cost
+of cloning grows with ``T^2 eps``, DAgger's with ``T eps``). DAgger
+(their Algorithm 3.1) iterates:
+
+1. iteration 0: roll out the teacher (their ``beta_1 = 1``), record its
+   ``(observation, action)`` pairs, fit the learner on them (= cloning);
+2. iteration ``i >= 1``: roll out the *learner* (``beta_i = 0``, the
+   setting their experiments use), label every state it visits with the
+   teacher's action there, aggregate with every earlier pair, refit.
+
+The teachers here are :mod:`motiongym.baselines` policies, some with a
+per-episode memory (the excavator's IK goals and waypoint index, the harvest
+arm's planned path and progress on it, the dual-arm schedule). Along a
+learner's episode the teacher is queried at *every* step in order, with its
+memory reset at the episode's first observation (``episode_start``): its
+plan is made from the same first observation as on its own, and its
+progress (waypoint index, nearest path point, schedule step) is read from
+the learner's states, so each label is "what the teacher does from here,
+given the plan it made at the start". The learner never sees the memory:
+it acts from the observation alone.
+
+Episodes of iteration ``i`` are seeded ``seed + i * episodes + j`` (default
+:data:`~motiongym.agents.dataset.DATASET_SEED`, far from the evaluation
+seeds). With an observation normalisation (``VecNormalize``), its statistics
+are the teacher's states of iteration 0, then frozen, as cloning does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from stable_baselines3.common.base_class import BaseAlgorithm
+from stable_baselines3.common.vec_env import VecNormalize
+
+from motiongym.agents.dataset import DATASET_SEED
+from motiongym.agents.imitation import behaviour_clone
+from motiongym.envs.core import check_int
+
+
+@dataclass
+class DaggerIteration:
+    """One iteration's figures: who acted, on how many states, how well."""
+
+    iteration: int
+    actor: str  # "teacher" (iteration 0) or "learner"
+    episodes: int
+    success: float  # the acting policy's success rate on this iteration's episodes
+    label_error: float | None  # mean squared error, learner vs teacher, on the new states,
+    # before the refit (None where the teacher acted)
+    states: int  # size of the aggregated data set after this iteration
+    loss: float  # the last refit epoch's mean loss
+
+
+def _rollout(
+    env: gym.Env, teacher: Any, learner: Any, seed: int
+) -> tuple[list[Any], list[np.ndarray], list[np.ndarray], bool]:
+    """One episode acted by ``learner`` (or the teacher where None), labelled by the teacher.
+
+    Returns the observations, the teacher's actions, the learner's actions
+    (empty where the teacher acted) and the episode's ``is_success``.
+    """
+    observation, info = env.reset(seed=seed)
+    observations, labels, guesses = [], [], []
+    start, done = True, False
+    while not done:
+        label, _ = teacher.predict(observation, episode_start=np.array([start]))
+        start = False
+        action = label
+        if learner is not None:
+            action = learner(observation)
+            guesses.append(np.asarray(action, dtype=np.float64))
+        observations.append(observation)
+        labels.append(np.asarray(label, dtype=np.float64))
+        observation, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    return observations, labels, guesses, bool(info.get("is_success", False))
+
+
+def _learner(model: BaseAlgorithm, env: gym.Env, normalization: VecNormalize | None):
+    """The model's deterministic action for one raw observation, within the action box."""
+    if not isinstance(env.action_space, gym.spaces.Box):
+        raise ValueError(f"env must have a Box action space, got {env.action_space}")
+    if not isinstance(env.observation_space, gym.spaces.Box):  # the aggregate is one array
+        raise ValueError(
+            f"env must have a Box observation space (the non-goal IDs), got "
+            f"{type(env.observation_space).__name__}"
+        )
+    low, high = env.action_space.low, env.action_space.high
+
+    def act(observation: Any) -> np.ndarray:
+        if normalization is not None:
+            observation = normalization.normalize_obs(observation)
+        action, _ = model.predict(observation, deterministic=True)
+        return np.clip(action, low, high)
+
+    return act
+
+
+def on_policy_error(
+    model: BaseAlgorithm,
+    env: gym.Env,
+    teacher: Any,
+    seeds: range,
+    normalization: VecNormalize | None = None,
+) -> tuple[float, float]:
+    """``(mean squared error to the teacher on the learner's own states, success rate)``.
+
+    DAgger's measure (Ross et al.'s expected loss under the learner's state
+    distribution): the learner acts on episodes ``seeds``, the teacher labels.
+    """
+    act = _learner(model, env, normalization)
+    errors, successes = [], []
+    for seed in seeds:
+        _, labels, guesses, success = _rollout(env, teacher, act, seed)
+        errors.append(np.mean((np.asarray(guesses) - np.asarray(labels)) ** 2, axis=1))
+        successes.append(success)
+    return float(np.mean(np.concatenate(errors))), float(np.mean(successes))
+
+
+def dagger(
+    model: BaseAlgorithm,
+    env: gym.Env,
+    teacher: Any,
+    iterations: int = 4,
+    episodes: int = 50,
+    epochs: int = 20,
+    seed: int = DATASET_SEED,
+    normalization: VecNormalize | None = None,
+    training_seed: int = 0,
+) -> list[DaggerIteration]:
+    """Teach ``model``'s policy by DAgger; the figures of each iteration (0: cloning).
+
+    Args:
+        model: an SB3 model whose policy is fitted (``behaviour_clone``).
+        env: a made single environment of the teacher's ID (a Box action space).
+        teacher: a predictor with per-episode memory reset by ``episode_start``
+            (a scripted policy).
+        iterations: learner-acting iterations after the teacher's (0: plain cloning).
+        episodes: episodes rolled out per iteration.
+        epochs: cloning epochs per refit, over the whole aggregated set.
+        seed: the first episode's seed.
+        normalization: observation statistics, set from iteration 0's states, then frozen.
+        training_seed: seeds the refits' minibatch order.
+    """
+    check_int("iterations", iterations, 0, 10_000)
+    check_int("episodes", episodes, 1, 10**6)
+    learner = _learner(model, env, normalization)
+    normalize = normalization.normalize_obs if normalization is not None else (lambda o: o)
+
+    observations: list[Any] = []
+    labels: list[np.ndarray] = []
+    history = []
+    for iteration in range(iterations + 1):
+        acting = learner if iteration else None
+        new_obs, new_labels, guesses, successes = [], [], [], []
+        for j in range(episodes):
+            obs, lab, guess, success = _rollout(
+                env, teacher, acting, seed + iteration * episodes + j
+            )
+            new_obs += obs
+            new_labels += lab
+            guesses += guess
+            successes.append(success)
+        if iteration == 0 and normalization is not None:
+            normalization.obs_rms.update(np.asarray(new_obs))
+            normalization.training = False
+        error = (
+            float(np.mean((np.asarray(guesses) - np.asarray(new_labels)) ** 2)) if guesses else None
+        )
+        observations += new_obs
+        labels += new_labels
+        losses = behaviour_clone(
+            model,
+            normalize(np.asarray(observations)),
+            np.asarray(labels),
+            epochs=epochs,
+            seed=training_seed + iteration,
+        )
+        history.append(
+            DaggerIteration(
+                iteration,
+                "learner" if iteration else "teacher",
+                episodes,
+                float(np.mean(successes)),
+                error,
+                len(labels),
+                losses[-1],
+            )
+        )
+    return history
+
+
+def history_json(history: list[DaggerIteration]) -> list[dict[str, Any]]:
+    """The iterations as plain dicts (``dagger.json`` of a run)."""
+    return [asdict(item) for item in history]

@@ -1,0 +1,158 @@
+"""DAgger with a scripted teacher (motiongym.agents.dagger) and its train/ship route, by number."""
+
+from __future__ import annotations
+
+import json
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+import yaml
+from stable_baselines3 import SAC
+from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+from motiongym.agents.dagger import dagger, on_policy_error
+from motiongym.agents.dataset import DATASET_SEED
+from motiongym.agents.errors import UsageError
+from motiongym.agents.train import train
+from motiongym.baselines import make_policy
+
+REACH = "motiongym/ExcavatorReach-v1"
+TINY = {
+    "n_timesteps": 0,
+    "policy": "MlpPolicy",
+    "policy_kwargs": {"net_arch": [32, 32]},
+    "imitate": "newton-raphson-reach",
+    "dagger_iterations": 1,
+    "dagger_episodes": 2,
+    "bc_epochs": 2,
+    "normalize": {"norm_reward": False},
+    "env_kwargs": {"max_episode_steps": 30},
+}
+
+
+def _learner(seed: int, width: int):
+    env = gym.make(REACH)
+    venv = VecNormalize(DummyVecEnv([lambda: gym.make(REACH)]), norm_reward=False)
+    model = SAC("MlpPolicy", venv, policy_kwargs={"net_arch": [width, width]}, seed=seed)
+    teacher = make_policy(
+        REACH, "newton-raphson-reach", env.observation_space, env.action_space, env.spec.kwargs
+    )
+    return env, venv, model, teacher
+
+
+def _teacher_episode(env: gym.Env, seed: int) -> tuple[int, bool]:
+    """(steps, success) of the teacher alone on the episode ``seed``."""
+    teacher = make_policy(
+        REACH, "newton-raphson-reach", env.observation_space, env.action_space, env.spec.kwargs
+    )
+    observation, _ = env.reset(seed=seed)
+    steps, done = 0, False
+    while not done:
+        observation, _, terminated, truncated, info = env.step(teacher.predict(observation)[0])
+        steps, done = steps + 1, terminated or truncated
+    return steps, bool(info["is_success"])
+
+
+def _config(tmp_path, **changes):
+    path = tmp_path / "dagger.yml"
+    path.write_text(yaml.safe_dump({"sac": {**TINY, **changes}}))
+    return path
+
+
+def test_a_dagger_run_teaches_without_rl_and_ships_with_its_kind(tmp_path):
+    """``imitate`` in a block: iteration 0 is the teacher's (its success, no label error),
+    then the learner's; no RL with n_timesteps 0; shipped as ``sac-dagger``, kind
+    ``demonstrations``, and found by that name."""
+    from motiongym.agents.ship import ship
+
+    run_dir = train(REACH, "sac", _config(tmp_path), out_root=tmp_path / "runs", progress=False)
+    record = json.loads((run_dir / "dagger.json").read_text())
+    first, second = record["iterations"]
+    assert (first["actor"], second["actor"]) == ("teacher", "learner")
+    env = gym.make(REACH, max_episode_steps=30)
+    alone = [_teacher_episode(env, seed) for seed in (DATASET_SEED, DATASET_SEED + 1)]
+    assert first["label_error"] is None and first["success"] == np.mean([s for _, s in alone])
+    assert first["states"] == sum(n for n, _ in alone) and second["label_error"] > 0
+    assert first["states"] < second["states"] <= first["states"] + 60
+    assert (run_dir / "vecnormalize.npz").is_file() and not (run_dir / "eval").exists()
+    shipped = ship([run_dir], n_episodes=1, root=tmp_path / "pretrained")
+    assert shipped.folder.name == "sac-dagger"
+    metrics = json.loads((shipped.folder / "metrics.json").read_text())
+    assert metrics["kind"] == "demonstrations" and metrics["runs"][0]["dagger_seconds"] > 0
+
+
+def test_dagger_training_is_deterministic_from_its_seed(tmp_path):
+    """Two runs of the same block and seed: the same figures and weights, bit for bit."""
+    from motiongym.agents.predictors import load_model
+
+    figures, weights = [], []
+    env = gym.make(REACH)
+    for name in ("a", "b"):
+        run_dir = train(
+            REACH, "sac", _config(tmp_path), seed=3, out_root=tmp_path / name, progress=False
+        )
+        record = json.loads((run_dir / "dagger.json").read_text())["iterations"]
+        figures.append([(i["loss"], i["label_error"], i["states"]) for i in record])
+        actor = load_model(run_dir, env, REACH).model.policy.actor.state_dict()
+        weights.append(torch.cat([v.flatten() for v in actor.values()]))
+    assert figures[0] == figures[1]
+    assert torch.equal(weights[0], weights[1])
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"imitate": "potential-field"}, "imitate 'potential-field' is not a scripted policy"),
+        (
+            {"residual": "newton-raphson-reach"},
+            "cannot be combined with demonstrations or residual",
+        ),
+        ({"imitate": None}, "n_timesteps 0 .no RL. needs imitate or demonstrations"),
+        ({"dagger_iterations": -1}, "dagger_iterations"),
+        ({"imitate": 3}, "imitate must be a scripted policy's name, got 3"),
+    ],
+)
+def test_bad_imitation_blocks_are_refused_by_name(tmp_path, changes, message):
+    with pytest.raises(UsageError, match=message):
+        train(REACH, "sac", _config(tmp_path, **changes), out_root=tmp_path, progress=False)
+    assert not (tmp_path / "ExcavatorReach-v1").exists()
+
+
+def test_dagger_refuses_a_discrete_action_space():
+    env = gym.make("motiongym/Sweeper-v1")
+    with pytest.raises(ValueError, match="env must have a Box action space, got Discrete"):
+        dagger(None, env, None)
+    with pytest.raises(ValueError, match="Box observation space .the non-goal IDs., got Dict"):
+        dagger(None, gym.make("motiongym/HarvestArmGoal-v1"), None)
+    with pytest.raises(ValueError, match="iterations"):
+        dagger(None, gym.make(REACH), None, iterations=-1)
+
+
+@pytest.mark.slow
+def test_dagger_iterations_lower_the_error_on_the_learners_own_states():
+    """The ablation: the same labelling budget (20 episodes), spent on the teacher's states
+    (iterations 0: behaviour cloning) or on the learner's (3 DAgger iterations of 5):
+    DAgger's error to the teacher on the learner's own held-out episodes is at least 2x
+    lower for each of two seeds (measured 0.108 vs 0.025 and 0.089 vs 0.022,
+    docs/experiments/ExcavatorReach-v1.md)."""
+    for seed in (0, 1):
+        errors = []
+        for iterations, episodes in ((0, 20), (3, 5)):
+            torch.manual_seed(seed)
+            env, venv, model, teacher = _learner(seed, 64)
+            dagger(
+                model,
+                env,
+                teacher,
+                iterations,
+                episodes,
+                10,
+                normalization=venv,
+                training_seed=seed,
+            )
+            error, _ = on_policy_error(model, env, teacher, range(100_000, 100_020), venv)
+            errors.append(error)
+        assert errors[1] < 0.5 * errors[0], errors
+    assert np.isfinite(errors).all()
