@@ -17,7 +17,7 @@ def one_shipped_id(monkeypatch, shipped_folder):
 
 def test_pooled_evaluation_holds_every_seed_episode(shipped_folder):
     evaluation, metrics = benchmarks.pooled_evaluation(shipped_folder)
-    assert evaluation.policy == "ppo (2 seeds)"
+    assert evaluation.policy == "ppo (from scratch, 2 seeds)"
     assert len(evaluation.episodes) == 2 * len(metrics["held_out_seeds"])
 
 
@@ -34,7 +34,7 @@ def test_benchmarks_rewrites_only_the_generated_part(one_shipped_id, tmp_path):
     assert text.index(benchmarks.END) < text.index("reading below")
     generated = text.split(benchmarks.BEGIN)[1].split(benchmarks.END)[0]
     header = next(line for line in generated.splitlines() if line.startswith("| measure"))
-    assert "newton-raphson-reach" in header and "ppo (2 seeds)" in header
+    assert "newton-raphson-reach" in header and "ppo (from scratch, 2 seeds)" in header
     assert "over 2 or 4 episodes per policy" in generated
     assert (tmp_path / "docs" / "benchmarks" / "ExcavatorReach-v0.png").is_file()
     assert "](docs/benchmarks/ExcavatorReach-v0.png)" in generated

@@ -65,4 +65,4 @@ def test_shipped_metrics_and_benchmark_labels_say_how_the_runs_acted(shipped_fol
         run["deterministic"] = False
     (folder / "metrics.json").write_text(json.dumps(metrics))
     evaluation, _ = benchmarks.pooled_evaluation(folder)
-    assert evaluation.policy == "ppo (2 seeds, sampled)"
+    assert evaluation.policy == "ppo (from scratch, 2 seeds, sampled)"
