@@ -96,6 +96,8 @@ class PsaCwaPolicy(ScriptedPolicy):
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
     restart_axis = True  # a popped run may turn its lanes across (psa.restart_heading)
     push_behind = True  # push the segment in line behind a lane that starts after a shift
+    transfer = "quadtree"  # "quadtree": the chain of free squares plans it; "bfs": the ablation
+    corner_work = True  # False: the ablation that stops where CWA would start (wide restarts kept)
 
     localise = True  # correct the pose by scan matching when the odometry is noisy
     max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
@@ -185,9 +187,11 @@ class PsaCwaPolicy(ScriptedPolicy):
         return (r0, c0), occ, swept, cfree, cur
 
     def _plan(self, occ, swept, cfree, cur, goal) -> list[tuple[int, int]] | None:
-        """Quadtree transfer (:mod:`.quadtree`) sweeping the most unswept cells on its way."""
+        """Quadtree transfer (:mod:`.quadtree`) sweeping the most unswept cells on its way
+        (``transfer == "bfs"``: the shortest path over all known free configurations)."""
         gains = psa.entering_gains((~swept) & (occ != OBSTACLE), self.w)
-        return quadtree.plan(cfree, cur, goal, gains)
+        planner = quadtree.bfs_plan if self.transfer == "bfs" else quadtree.plan
+        return planner(cfree, cur, goal, gains)
 
     # -------------------------------------------------------------- PSA modes
     def _lane(self, m: Memory, r: int, c: int, h: int) -> int | None:
@@ -401,6 +405,9 @@ class PsaCwaPolicy(ScriptedPolicy):
         wide = (occupancy.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
         if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
             return self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
+        if not self.corner_work:
+            m.mode = "done"
+            return None
         m.cwa_stack = [
             ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
             for s, cells in cwa.scan_groups(targets, occ == OBSTACLE, self.w)
@@ -511,3 +518,16 @@ class PsaCwaDeadReckoningPolicy(PsaCwaPolicy):
     of the localiser (:mod:`.localise`), as the policy was before it."""
 
     localise = False
+
+
+class PsaCwaBfsTransferPolicy(PsaCwaPolicy):
+    """PSA + CWA with transfers along the shortest path over all known free
+    configurations: the ablation of the quadtree's route (:func:`.quadtree.bfs_plan`)."""
+
+    transfer = "bfs"
+
+
+class PsaNoCornerWorkPolicy(PsaCwaPolicy):
+    """PSA (with its restarts on wide leftovers) and no corner work: the ablation of CWA."""
+
+    corner_work = False

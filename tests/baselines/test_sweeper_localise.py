@@ -80,11 +80,18 @@ def test_diagnostics_report_done_and_pose() -> None:
 
 
 def test_localised_beats_dead_reckoning_on_the_room() -> None:
-    # measured (seed 0): 98.6 % localised, 80.6 % dead reckoning, both declared done
-    loc, loc_done = coverage_at_done(PsaCwaPolicy, 0, map_name="room", **NOISE)
-    dead, dead_done = coverage_at_done(PsaCwaDeadReckoningPolicy, 0, map_name="room", **NOISE)
-    assert loc_done and dead_done
-    assert loc > 0.97 and dead < 0.85
+    # measured (seeds 0-3, quadtree transfers): localised 99.6 / 98.5 / 98.5 / 98.3 %,
+    # dead reckoning 97.2 / 64.1 / 92.9 / 96.9 % (mean 87.8 %), all declared done; one
+    # seed alone does not separate them (seed 0: 98.6 / 80.6 % with BFS transfers)
+    loc, dead = [], []
+    for seed in range(4):
+        cov, done = coverage_at_done(PsaCwaPolicy, seed, map_name="room", **NOISE)
+        loc.append(cov)
+        cov, dead_done = coverage_at_done(PsaCwaDeadReckoningPolicy, seed, map_name="room", **NOISE)
+        dead.append(cov)
+        assert done and dead_done
+    assert min(loc) > 0.98 and np.mean(dead) < 0.9
+    assert all(a > b for a, b in zip(loc, dead, strict=True))
 
 
 @pytest.mark.slow
