@@ -89,7 +89,7 @@ class Memory:
 class PsaCwaPolicy(ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
-    pop_order = "lifo"
+    pop_order = "lifo"  # "lifo": LIFO by runs; "stack": the top entry; "nearest": any entry
     restart_wide = True  # a wide leftover restarts PSA instead of corner work
     slide_back = False  # shift further back along the lane when blocked at its end
     repush = True  # a popped segment goes back under the run it starts
@@ -330,6 +330,8 @@ class PsaCwaPolicy(ScriptedPolicy):
                 group, retry = [len(m.stack) - 1], False
             elif self.pop_order == "nearest":
                 group = range(len(m.stack))
+            elif self.pop_order == "stack":  # the plain stack: its top entry only
+                group = [len(m.stack) - 1]
             else:
                 group = m.stack.top_run()
             found = {k: t for k in group if (t := restart(m.stack.items[k])) is not None}
