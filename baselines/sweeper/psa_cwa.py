@@ -20,8 +20,11 @@ proof of a wall at that point (the felt marks are dropped and the map looked
 at again), and a scan that finds the same leftovers as the last one sends
 the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
 :class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
-dead-reckoned pose. ``diagnostics()["done"]`` says when the policy has
-declared itself done.
+dead-reckoned pose; :class:`PsaCwaBfsTransferPolicy` the one that moves
+between runs along the shortest path over all known free configurations
+instead of the quadtree's chain of squares; :class:`PsaNoCornerWorkPolicy`
+the one without CWA (``tests/baselines/test_sweeper_corner_work.py``).
+``diagnostics()["done"]`` says when the policy has declared itself done.
 """
 
 from __future__ import annotations
