@@ -43,6 +43,11 @@ import numpy as np
 import motiongym  # noqa: F401  (registers the IDs)
 from motiongym.agents.reproduce import sweeper_odometry
 from motiongym.agents.sweeper_runs import run_sweep, sweeper_policy
+from motiongym.baselines.sweeper.psa_cwa import (
+    PsaCwaBfsTransferPolicy,
+    PsaCwaPolicy,
+    PsaNoCornerWorkPolicy,
+)
 from motiongym.envs.sweeper import generator, maps, occupancy
 
 ENV_ID = "motiongym/Sweeper-v0"
@@ -94,8 +99,10 @@ def coverage_study(quick: bool) -> dict:
         nearest = [
             _episode(env, "psa-cwa-nearest", seed)["travel_ratio"] for seed in range(n_starts)
         ]
+        bfs = [_ablation(env, PsaCwaBfsTransferPolicy, seed) for seed in range(n_starts)]
         out[name] = {
             **_travel_against_bounds(runs, bounds),
+            **_transfer_against_bfs(runs, bfs),
             "travel_mean": float(np.mean([r["travel"] for r in runs])),
             "travel_ratio_max": float(np.max([r["travel_ratio"] for r in runs])),
             "nearest_first_ratio_mean": float(np.mean(nearest)),
@@ -112,11 +119,51 @@ def coverage_study(quick: bool) -> dict:
     for seed in range(n_random):
         runs.append(_episode(env, "psa-cwa", 1000 + seed))
         bounds.append(_bound(env))
+    bfs = [_ablation(env, PsaCwaBfsTransferPolicy, 1000 + seed) for seed in range(n_random)]
     out["procedural"] = {
         **_travel_against_bounds(runs, bounds),
+        **_transfer_against_bfs(runs, bfs),
         "all_swept": int(sum(r["is_success"] for r in runs)),
     }
     return out
+
+
+def _ablation(env: gym.Env, policy_class: type, seed: int, env_id: str = ENV_ID) -> dict:
+    """One episode of a policy class that has no registered name (an ablation)."""
+    kwargs = {**gym.spec(env_id).kwargs, "robot_width": W}
+    return run_sweep(env, policy_class(env.observation_space, env.action_space, kwargs), seed)
+
+
+def _transfer_against_bfs(runs: list[dict], bfs: list[dict]) -> dict:
+    """Travel between runs (mode group "transfer") along the quadtree's chain against the
+    ablation that moves along the shortest path over all known free configurations."""
+    return {
+        "transfer_mean": float(np.mean([r["travel_by_mode"]["transfer"] for r in runs])),
+        "transfer_bfs_mean": float(np.mean([r["travel_by_mode"]["transfer"] for r in bfs])),
+        "travel_bfs_mean": float(np.mean([r["travel"] for r in bfs])),
+    }
+
+
+def corner_work_study(quick: bool) -> dict:
+    """CWA at work (paper Fig. 9 -> 10) on :func:`.generator.corner_room`, on Sweeper-v1.
+
+    Walls at 45 degrees to the lanes: PSA leaves triangles along them that CWA
+    sweeps. Reports PSA's coverage at the hand-over, the final coverage, CWA's
+    share of the travel, and the coverage of the ablation without CWA.
+    """
+    env_id = "motiongym/Sweeper-v1"
+    env = gym.make(env_id, grid=generator.corner_room(), robot_width=W)
+    seeds = range(3 if quick else 10)
+    full = [_ablation(env, PsaCwaPolicy, s, env_id) for s in seeds]
+    cut = [_ablation(env, PsaNoCornerWorkPolicy, s, env_id) for s in seeds]
+    return {
+        "episodes": len(full),
+        "psa_coverage_mean": float(np.mean([r["psa_coverage"] for r in full])),
+        "coverage_min": float(min(r["coverage"] for r in full)),
+        "travel_shares": _shares(full),
+        "no_cwa_coverage_mean": float(np.mean([r["coverage"] for r in cut])),
+        "no_cwa_coverage_max": float(max(r["coverage"] for r in cut)),
+    }
 
 
 def _travel_against_bounds(runs: list[dict], bounds: list[occupancy.SmartDfsBound]) -> dict:
@@ -138,7 +185,23 @@ def _travel_against_bounds(runs: list[dict], bounds: list[occupancy.SmartDfsBoun
 
 
 def start_position_study(quick: bool) -> dict:
-    """Travel from every feasible start configuration of the maze (heading east)."""
+    """Travel from every feasible start configuration of the maze (heading east).
+
+    The paper's measure (4.1.2): the travel distance from start to finish
+    from "every point where sweeping can start", its spread the difference
+    of the longest and shortest travel over the whole travel: 650 / 20843 =
+    3.1 % of the longest, 650 / 20193 = 3.2 % of the shortest. Reported:
+    ``spread`` ``(max - min) / min`` and ``spread_of_max`` ``(max - min) /
+    max`` of the travel (cells, the paper's measure), the same of the turns
+    and of the steps (time: one action a step), the 5-95 % quantile range
+    over the median, and the travel split into sweeping (lanes and shifts)
+    and moving between runs (transfers and corner work) with each part's
+    standard deviation over the starts; and the part of the travel that the
+    start's alignment explains (the paper's Fig. 15: travel periodic with the
+    gap to the walls modulo the robot width): the mean travel of each class
+    of starts ``(row mod W, column mod W)``, the range of those means over
+    the mean travel, and the share of the variance they explain.
+    """
     env = _env(map_name="maze")
     grid = maps.shipped_map("maze")
     free = occupancy.config_free(grid, W)
@@ -146,15 +209,37 @@ def start_position_study(quick: bool) -> dict:
     starts = [tuple(int(v) for v in p) for p in np.argwhere(free) if p[0] % stride == 0]
     starts = [p for p in starts if p[1] % stride == 0]
     travel = np.full(grid.shape, np.nan)
+    runs = []
     for start in starts:
         r = _episode(env, "psa-cwa", 0, {"start": start, "heading": 0})
         travel[start] = r["travel"]
+        runs.append(r)
     vals = travel[~np.isnan(travel)]
+    turns = np.array([r["turns"] for r in runs], float)
+    steps = np.array([r["steps"] for r in runs], float)
+    by = {k: np.array([r["travel_by_mode"][k] for r in runs]) for k in ("lane", "shift")}
+    between = {k: np.array([r["travel_by_mode"][k] for r in runs]) for k in ("transfer", "cwa")}
+    p5, p50, p95 = np.percentile(vals, [5, 50, 95])
+    at = np.array(starts)
+    cls = (at[:, 0] % W) * W + at[:, 1] % W
+    trav = np.array([r["travel"] for r in runs], float)
+    means = np.array([trav[cls == k].mean() if (cls == k).any() else np.nan for k in range(W * W)])
+    resid = trav - means[cls]
     return {
         "starts": len(starts),
         "travel_min": float(vals.min()),
         "travel_max": float(vals.max()),
         "spread": float((vals.max() - vals.min()) / vals.min()),
+        "spread_of_max": float((vals.max() - vals.min()) / vals.max()),
+        "spread_p5_p95": float((p95 - p5) / p50),
+        "turns_spread": _spread(list(turns)),
+        "steps_spread": _spread(list(steps)),
+        "travel_std": float(vals.std()),
+        "sweeping_std": float((by["lane"] + by["shift"]).std()),
+        "between_runs_std": float((between["transfer"] + between["cwa"]).std()),
+        "between_runs_mean": float((between["transfer"] + between["cwa"]).mean()),
+        "alignment_range": float((np.nanmax(means) - np.nanmin(means)) / trav.mean()),
+        "alignment_variance_share": float(1.0 - resid.var() / trav.var()),
         "image": travel,
     }
 
@@ -367,6 +452,7 @@ def _print(results: dict) -> None:
         "no-hole formula, below",
         "nearest-first, below",
         "travel % l/s/t/c",
+        "transfer quadtree / BFS",
     ):
         t.add_column(col)
     for name, row in results["coverage"].items():
@@ -384,14 +470,27 @@ def _print(results: dict) -> None:
             if procedural
             else f"{row['nearest_first_ratio_mean']:.2f}, {row['nearest_first_below_smartdfs']}",
             _share_text(row["travel_shares"]),
+            f"{row['transfer_mean']:.0f} / {row['transfer_bfs_mean']:.0f}",
         )
+    cw = results["corner_work"]
+    t.add_row(
+        f"corner room x{cw['episodes']} (v1)",
+        f"{100 * cw['coverage_min']:.1f} % (PSA {100 * cw['psa_coverage_mean']:.1f} %)",
+        *[""] * 5,
+        _share_text(cw["travel_shares"]),
+        f"no CWA: {100 * cw['no_cwa_coverage_mean']:.1f} %",
+    )
     console.print(t)
     console.print(
         "paper: full coverage of Fig. 6, 11 and 12 whatever the obstacles. ratio: travel / "
         "(area / W); bound: W x steps / (area / W), steps C + E/2 - 3 (SmartDFS, no holes) or "
         "C + E/2 + 3H - 2 (H obstacles), robot-scale cells anchored at the start; the "
         "no-hole formula C + E/2 - 3 on every map is stricter; nearest-first: an ablation "
-        "(psa-cwa-nearest), not the paper's stack order"
+        "(psa-cwa-nearest), not the paper's stack order. travel % lanes/shifts/transfers "
+        "(between runs)/CWA; transfer: cells moved between runs along the quadtree's chain of "
+        "free squares (paper 3.2) / along the shortest path over all known free cells (the "
+        "ablation). corner room: walls at 45 degrees to the lanes (paper Fig. 6, 9 -> 10), "
+        "PSA's coverage when it hands over to CWA and the ablation without CWA"
     )
 
     sp, ori, wk = results["start_position"], results["orientation"], results["weak_baseline"]
@@ -399,9 +498,28 @@ def _print(results: dict) -> None:
     for col in ("measure", "ours", "paper"):
         t.add_column(col)
     t.add_row(
-        f"start position spread (maze, {sp['starts']} starts)",
-        f"{100 * sp['spread']:.1f} % ({sp['travel_min']:.0f}..{sp['travel_max']:.0f} cells)",
-        "3 % (20193..20843 base units)",
+        f"start position spread of travel, (max - min) / min and / max (maze, {sp['starts']} "
+        "starts heading east)",
+        f"{100 * sp['spread']:.1f} / {100 * sp['spread_of_max']:.1f} % "
+        f"({sp['travel_min']:.0f}..{sp['travel_max']:.0f} cells)",
+        "3.2 / 3.1 % (20193..20843 base units, every start)",
+    )
+    t.add_row(
+        "  same starts: 5-95 % range / median; turns; steps (time)",
+        f"{100 * sp['spread_p5_p95']:.1f} %; {100 * sp['turns_spread']:.0f} %; "
+        f"{100 * sp['steps_spread']:.0f} %",
+        "travel only",
+    )
+    t.add_row(
+        f"  alignment: range of mean travel over starts (row, column) mod {W}; variance share",
+        f"{100 * sp['alignment_range']:.1f} % of the mean; "
+        f"{100 * sp['alignment_variance_share']:.0f} % of the variance",
+        "periodic in the start (Fig. 15), all of the 3 %",
+    )
+    t.add_row(
+        "  std of travel: all / sweeping (lanes, shifts) / between runs (transfers, CWA)",
+        f"{sp['travel_std']:.1f} / {sp['sweeping_std']:.1f} / {sp['between_runs_std']:.1f} cells",
+        "",
     )
     t.add_row(
         f"start orientation spread (maze, 4 headings at {tuple(ori['start'])})",
@@ -460,6 +578,7 @@ def run(out_dir: pathlib.Path, quick: bool = False, seeds: int | None = None) ->
     t0 = time.perf_counter()
     results: dict[str, Any] = {"paper": PAPER, "robot_width": W, "quick": quick}
     results["coverage"] = coverage_study(quick)
+    results["corner_work"] = corner_work_study(quick)
     results["start_position"] = start_position_study(quick)
     results["orientation"] = orientation_study(quick)
     results["odometry"] = sweeper_odometry.odometry_table(quick, seeds)

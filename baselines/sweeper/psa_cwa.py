@@ -20,8 +20,11 @@ proof of a wall at that point (the felt marks are dropped and the map looked
 at again), and a scan that finds the same leftovers as the last one sends
 the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
 :class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
-dead-reckoned pose. ``diagnostics()["done"]`` says when the policy has
-declared itself done.
+dead-reckoned pose; :class:`PsaCwaBfsTransferPolicy` the one that moves
+between runs along the shortest path over all known free configurations
+instead of the quadtree's chain of squares; :class:`PsaNoCornerWorkPolicy`
+the one without CWA (``tests/baselines/test_sweeper_corner_work.py``).
+``diagnostics()["done"]`` says when the policy has declared itself done.
 """
 
 from __future__ import annotations
@@ -92,13 +95,15 @@ class Memory:
 class PsaCwaPolicy(ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
-    pop_order = "lifo"
+    pop_order = "lifo"  # "lifo": LIFO by runs; "stack": the top entry; "nearest": any entry
     restart_wide = True  # a wide leftover restarts PSA instead of corner work
     slide_back = False  # shift further back along the lane when blocked at its end
     repush = True  # a popped segment goes back under the run it starts
     cwa_order = "scan"  # "scan": the paper's scan-order stack; "nearest": nearest group first
     restart_axis = True  # a popped run may turn its lanes across (psa.restart_heading)
     push_behind = True  # push the segment in line behind a lane that starts after a shift
+    transfer = "quadtree"  # "quadtree": the chain of free squares plans it; "bfs": the ablation
+    corner_work = True  # False: the ablation that stops where CWA would start (wide restarts kept)
 
     localise = True  # correct the pose by scan matching when the odometry is noisy
     max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
@@ -188,9 +193,11 @@ class PsaCwaPolicy(ScriptedPolicy):
         return (r0, c0), occ, swept, cfree, cur
 
     def _plan(self, occ, swept, cfree, cur, goal) -> list[tuple[int, int]] | None:
-        """Quadtree transfer (:mod:`.quadtree`) sweeping the most unswept cells on its way."""
+        """Quadtree transfer (:mod:`.quadtree`) sweeping the most unswept cells on its way
+        (``transfer == "bfs"``: the shortest path over all known free configurations)."""
         gains = psa.entering_gains((~swept) & (occ != OBSTACLE), self.w)
-        return quadtree.plan(cfree, cur, goal, gains)
+        planner = quadtree.bfs_plan if self.transfer == "bfs" else quadtree.plan
+        return planner(cfree, cur, goal, gains)
 
     # -------------------------------------------------------------- PSA modes
     def _lane(self, m: Memory, r: int, c: int, h: int) -> int | None:
@@ -334,6 +341,8 @@ class PsaCwaPolicy(ScriptedPolicy):
                 group, retry = [len(m.stack) - 1], False
             elif self.pop_order == "nearest":
                 group = range(len(m.stack))
+            elif self.pop_order == "stack":  # the plain stack: its top entry only
+                group = [len(m.stack) - 1]
             else:
                 group = m.stack.top_run()
             found = {k: t for k in group if (t := restart(m.stack.items[k])) is not None}
@@ -411,6 +420,9 @@ class PsaCwaPolicy(ScriptedPolicy):
         wide = (occupancy.box_sum(targets.astype(np.int64), self.w) == self.w * self.w) & reach
         if self.restart_wide and wide.any():  # a region PSA missed, not a corner: restart PSA there
             self._restart_psa(m, r, c, origin, occ, swept, cfree, cur, wide, targets)
+            return None
+        if not self.corner_work:
+            m.mode = "done"
             return None
         m.cwa_stack = [
             ((s[0] + origin[0], s[1] + origin[1]), cells + np.array(origin))
@@ -524,3 +536,16 @@ class PsaCwaDeadReckoningPolicy(PsaCwaPolicy):
     of the localiser (:mod:`.localise`), as the policy was before it."""
 
     localise = False
+
+
+class PsaCwaBfsTransferPolicy(PsaCwaPolicy):
+    """PSA + CWA with transfers along the shortest path over all known free
+    configurations: the ablation of the quadtree's route (:func:`.quadtree.bfs_plan`)."""
+
+    transfer = "bfs"
+
+
+class PsaNoCornerWorkPolicy(PsaCwaPolicy):
+    """PSA (with its restarts on wide leftovers) and no corner work: the ablation of CWA."""
+
+    corner_work = False

@@ -15,18 +15,17 @@ into cell moves: inside a free square any monotone (L-shaped) path between
 two of its cells stays in it, so the path goes from the current cell to the
 exit cell facing the next square, steps across, and so on to the goal.
 
-Our choice where the paper is silent (it takes the decomposition for its
-completeness and low cost; the path is a means): the policy moves along a
-shortest path over the known free configurations, and of those, one that
-sweeps the most cells not yet swept on its way (:func:`best_path`, gains
-from :func:`.psa.entering_gains`): a transfer that passes along a leftover
-strip sweeps it, where an L-shaped path might miss it and leave it to a
-later transfer. The quadtree's chain still decides whether a path exists.
-Restricted to the chain's squares the choice gained nothing measurable; over
-all free cells, mean travel ratio over 40 room starts 1.334 -> 1.326 (below
-SmartDFS's from 37 -> 38 starts), over procedural maps 2000-2059
-1.378 -> 1.353 (43 -> 48 below), the maze unchanged (1.486 -> 1.484 over
-40 starts).
+The quadtree plans the route (our reading of Latombe's "channel"): A* over
+the free leaves' adjacency graph (edge cost: distance between the squares'
+centres) gives the chain of squares; the robot moves inside the union of
+those squares only (the channel), along a shortest path within it and, of
+those, one that sweeps the most cells not yet swept on its way
+(:func:`best_path`, gains from :func:`.psa.entering_gains`): a transfer
+that passes along a leftover strip sweeps it. Without gains the cells
+follow the chain square by square with L-shaped moves. :func:`bfs_plan`,
+the shortest path over all known free configurations with the quadtree only
+deciding that one exists, is kept as the ablation (the policy's transfers
+before issue 17); docs/experiments/Sweeper-v1.md compares their travel.
 """
 
 from __future__ import annotations
@@ -174,25 +173,51 @@ def best_path(
     return path[-2::-1]
 
 
+def channel(leaves: np.ndarray, chain: list[int], shape: tuple[int, ...]) -> np.ndarray:
+    """``(H, W)`` bool: the union of the chain's squares (4-connected from end to end)."""
+    out = np.zeros(shape, bool)
+    for r, c, s in leaves[chain].tolist():
+        out[r : r + s, c : c + s] = True
+    return out
+
+
 def plan(
     free: np.ndarray,
     start: tuple[int, int],
     goal: tuple[int, int],
     gains: np.ndarray | None = None,
 ) -> list[tuple[int, int]] | None:
-    """Cells from ``start`` (excluded) to ``goal`` over ``free`` (4-connected), or None.
+    """Cells from ``start`` (excluded) to ``goal`` through the quadtree's chain, or None.
 
-    Without ``gains``: L-shaped moves square by square along the chain. With
-    ``gains`` (see :func:`best_path`): the chain decides that a path exists,
-    and the path is, of the shortest ones over ``free``, one of greatest gain
-    (never longer than the former).
+    The chain of free squares (:func:`leaf_chain`) is the route. Without
+    ``gains``: L-shaped moves square by square along the chain. With
+    ``gains`` (see :func:`best_path`): of the shortest paths inside the
+    chain's squares (:func:`channel`), one of greatest gain.
     """
     leaves, label = decompose(free)
     chain = leaf_chain(leaves, label, start, goal)
     if chain is None:
         return None
     if gains is not None:
-        return best_path(free, start, goal, gains)
+        return best_path(channel(leaves, chain, free.shape), start, goal, gains)
+    return _chain_cells(leaves, chain, start, goal)
+
+
+def bfs_plan(
+    free: np.ndarray, start: tuple[int, int], goal: tuple[int, int], gains: np.ndarray
+) -> list[tuple[int, int]] | None:
+    """Ablation of :func:`plan`: the quadtree only decides that a path exists; the path is,
+    of the shortest ones over all of ``free``, one of greatest gain (never longer)."""
+    leaves, label = decompose(free)
+    if leaf_chain(leaves, label, start, goal) is None:
+        return None
+    return best_path(free, start, goal, gains)
+
+
+def _chain_cells(
+    leaves: np.ndarray, chain: list[int], start: tuple[int, int], goal: tuple[int, int]
+) -> list[tuple[int, int]]:
+    """L-shaped moves inside each square of ``chain``, crossing to the next where they touch."""
     path: list[tuple[int, int]] = []
     p = start
     for u, v in zip(chain[:-1], chain[1:], strict=True):

@@ -22,6 +22,26 @@ def empty_room(height: int, width: int) -> np.ndarray:
     return grid
 
 
+def corner_room(size: int = 41) -> np.ndarray:
+    """A room of the paper's Fig. 6 kind: every wall at 45 degrees to the lanes.
+
+    A diamond room (a square turned by 45 degrees, its walls staircases of
+    one-cell steps, ``size`` odd) with a diamond pillar and a round one.
+    Each lane stops where its footprint first meets a step and leaves a
+    small triangle between its front and the staircase unswept: the
+    leftovers along walls and obstacles of the paper's Fig. 9 that its
+    corner work sweeps (Fig. 10).
+    """
+    if size < 31 or size % 2 == 0:
+        raise ValueError(f"corner_room: size = {size}; allowed: an odd number >= 31")
+    h = size // 2
+    r, c = np.mgrid[0:size, 0:size]
+    grid = np.abs(r - h) + np.abs(c - h) > h - 1  # outside the diamond (its rim is wall)
+    grid |= np.abs(r - h + size // 6) + np.abs(c - h) <= 3  # diamond pillar
+    grid |= (r - h - size // 6) ** 2 + (c - h) ** 2 <= 9  # round pillar
+    return grid
+
+
 def furnished_room(rng: np.random.Generator, height: int, width: int, w: int) -> np.ndarray:
     """A room with 2-6 rectangular pieces of furniture, some against the walls."""
     grid = empty_room(height, width)
