@@ -19,8 +19,10 @@ The rules:
 
 - **Motion** (the environment's odometry model, with its noise levels
   known to the robot as its odometry spec): every action adds
-  ``N(0, heading_noise)`` to each particle's ``e``; a forward move that the
-  dead-reckoned pose shows made (no bump) moves each particle
+  ``N(0, heading_noise)`` to each particle's ``e``; a forward move (the
+  heading unchanged, as a turn always changes it, and no bump; not the
+  dead-reckoned pose changing, which the environment clips to the map's
+  extent, so that a drifted reckoning hides moves) moves each particle
   ``d ~ N(1, slip_noise)`` (clipped to ``[0, 1.4]``) along the commanded
   heading turned by ``e``; a bump leaves it where it was, and weighs down
   the particles whose move would have found a footprint the map holds free
@@ -71,6 +73,7 @@ class Localiser:
         self.e: np.ndarray = np.zeros(0)
         self.wt = np.full(n, 1.0 / n)
         self.reckoned: tuple[int, int] | None = None  # the last dead-reckoned cell
+        self.heading = 0  # the last observed (commanded) heading
         self.cell = (0, 0)
 
     def locate(self, robot_map: RobotMap, obs: dict) -> tuple[int, int]:
@@ -79,13 +82,15 @@ class Localiser:
         reckoned = int(round(float(pose[0]))), int(round(float(pose[1])))
         h = int(round(float(pose[2])))
         if self.reckoned is None:  # the first observation: the start is known exactly
-            self.reckoned, self.cell = reckoned, reckoned
+            self.reckoned, self.cell, self.heading = reckoned, reckoned, h
             self.y = np.full(self.n, float(reckoned[0]))
             self.x = np.full(self.n, float(reckoned[1]))
             self.e = np.zeros(self.n)
             return self.cell
-        self._move(reckoned != self.reckoned, h)
-        self.reckoned = reckoned
+        # a forward move that did not bump: the heading is unchanged (a turn always changes
+        # it) and no bump; the dead-reckoned cell is no witness, as it is clipped to the map
+        self._move(h == self.heading and pose[3] <= 0.5, h)
+        self.reckoned, self.heading = reckoned, h
         if pose[3] > 0.5:
             self._felt(robot_map, h)
         self._weigh(robot_map, obs)
