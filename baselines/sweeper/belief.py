@@ -103,20 +103,6 @@ class RobotMap:
             self.occ[self.felt] = UNKNOWN
         self.felt[:] = False
 
-    def doubt(self) -> int:
-        """Make walls not yet confirmed by ``evidence`` votes unknown again; return how many.
-
-        Under odometry error a window filed at a wrong pose leaves walls where
-        there is floor, and one across a door seals off what lies behind it;
-        before the robot believes the area swept it looks again at every wall
-        it has seen fewer than ``evidence`` times net (with votes only).
-        """
-        if not self.evidence:
-            return 0
-        weak = (self.occ == OBSTACLE) & (self.votes < self.evidence) & ~self.felt
-        self.occ[weak] = UNKNOWN
-        return int(weak.sum())
-
     def window(self) -> tuple[int, int, np.ndarray, np.ndarray]:
         """``(r0, c0, occ, swept)``: the explored box padded by ``w``; ``r0, c0`` its map origin.
 

@@ -44,7 +44,6 @@ from motiongym.envs.sweeper.params import SweeperParams
 FORWARD, LEFT, RIGHT = 0, 1, 2
 EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
 MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
-MAX_DOUBTS = 3  # times a localising policy doubts its unconfirmed walls before done
 
 
 def turn_towards(heading: int, target: int) -> int:
@@ -81,7 +80,6 @@ class Memory:
     cwa_last: tuple[int, int] | None = None  # (swept cells, leftovers) at the last scan
     steps: int = 0  # observations acted on
     stalled_at: int = -1  # the step of the last stall
-    doubts: int = 0  # times its unconfirmed walls were made unknown (belief.RobotMap.doubt)
     stalls: int = 0  # scans in a row that found the same leftovers (each sends it to the nearest)
     started: bool = False
     last_pose: tuple[int, int] | None = None
@@ -102,9 +100,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     localise = True  # correct the pose by scan matching when the odometry is noisy
     max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
     evidence = EVIDENCE  # map votes when localising (0: the latest window wins)
-    overlap = 1  # localising: cells each lane overlaps the last (shift w - overlap)
     sidestep = True  # localising: step aside after a bump the map does not explain
-    max_doubts = MAX_DOUBTS  # localising: times unconfirmed walls are looked at again
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -277,10 +273,9 @@ class PsaCwaPolicy(ScriptedPolicy):
         return plan
 
     def _shift_length(self, m: Memory, base: tuple[int, int], side: int) -> int:
-        """How many cells (up to ``w``, less the lane overlap) the robot can shift sideways
-        from ``base``."""
-        k, most = 0, self.w - (self.overlap if m.loc is not None else 0)
-        while k < most:
+        """How many cells (up to ``w``) the robot can shift sideways from ``base``."""
+        k = 0
+        while k < self.w:
             occ, _ = m.map.footprint(
                 base[0] + (k + 1) * int(DR[side]), base[1] + (k + 1) * int(DC[side])
             )
@@ -420,10 +415,6 @@ class PsaCwaPolicy(ScriptedPolicy):
         if self.max_stalls and not targets.any() and m.map.felt.any():  # a bump: look again
             m.map.forget_felt(unmark=True)
             return None
-        if self.max_stalls and not targets.any() and m.doubts < self.max_doubts:
-            m.doubts += 1  # no leftovers: look again at the walls seen too few times
-            if m.map.doubt():
-                return None
         state = (int(m.map.swept.sum()), int(targets.sum()))
         if state == m.cwa_last and targets.any() and m.stalls < self.max_stalls:
             if m.stalled_at == m.steps:  # stalled twice without acting: step off the spot

@@ -8,6 +8,8 @@ import pytest
 
 import motiongym  # noqa: F401
 from motiongym.agents.evaluate import run_episode
+from motiongym.baselines.sweeper.belief import RobotMap
+from motiongym.baselines.sweeper.localise import Localiser
 from motiongym.baselines.sweeper.psa_cwa import PsaCwaDeadReckoningPolicy, PsaCwaPolicy
 
 ENV_ID = "motiongym/Sweeper-v1"
@@ -77,6 +79,25 @@ def test_diagnostics_report_done_and_pose() -> None:
     d = policy.diagnostics()
     assert set(d) == {"mode", "done", "pose", "spread", "log"} and d["done"] is False
     assert d["pose"] == tuple(int(v) for v in obs["pose"][:2]) and d["spread"] == 0.0
+
+
+def _obs(row: int, col: int, heading: int, bump: bool) -> dict:
+    S = 3 + 2 * 3
+    free = np.zeros(S * S, np.float32)
+    return {"sensed": free, "known": free, "pose": np.array([row, col, heading, bump], np.float32)}
+
+
+def test_a_move_is_read_from_the_heading_not_the_clipped_reckoning() -> None:
+    """The environment clips the dead-reckoned cell to the map: a forward move at the
+    edge leaves it unchanged. The localiser still moves its particles one cell along the
+    heading (east: column + 1); a bump or a turn does not move them."""
+    loc = Localiser(3, 3, heading_noise=0.0, slip_noise=0.0, n=8)
+    robot_map = RobotMap(3, 3)
+    assert loc.locate(robot_map, _obs(5, 5, 0, False)) == (5, 5)
+    assert loc.locate(robot_map, _obs(5, 5, 0, False)) == (5, 6)  # moved, reckoning clipped
+    assert loc.locate(robot_map, _obs(5, 5, 0, True)) == (5, 6)  # a bump
+    assert loc.locate(robot_map, _obs(5, 5, 1, False)) == (5, 6)  # a turn
+    assert loc.locate(robot_map, _obs(4, 5, 1, False)) == (4, 6)  # north
 
 
 def test_localised_beats_dead_reckoning_on_the_room() -> None:
