@@ -19,6 +19,10 @@ the map holds no reachable floor unswept or unknown: a bump is not taken as
 proof of a wall at that point (the felt marks are dropped and the map looked
 at again), and a scan that finds the same leftovers as the last one sends
 the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
+A bump where the map holds the footprint ahead free (the continuous pose,
+drifted by the heading error, rounds into the wall beside the path) sends
+the robot one cell sideways, against the estimated drift, and its bump
+marks become unknown, not walls, once it has moved on.
 :class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
 dead-reckoned pose. ``diagnostics()["done"]`` says when the policy has
 declared itself done.
