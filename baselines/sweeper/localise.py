@@ -23,8 +23,12 @@ The rules:
   heading unchanged, as a turn always changes it, and no bump; not the
   dead-reckoned pose changing, which the environment clips to the map's
   extent, so that a drifted reckoning hides moves) moves each particle
-  ``d ~ N(1, slip_noise)`` (clipped to ``[0, 1.4]``) along the commanded
-  heading turned by ``e``; a bump leaves it where it was, and weighs down
+  ``d ~ N(1, max(slip_noise, 0.05))`` (clipped to ``[0, 1.4]``) along the
+  commanded heading turned by ``e``; the floor is roughening (Gordon,
+  Salmond & Smith 1993): with exact moves the particles differ only by
+  their heading error, resampling leaves a few tracks, and a pose error
+  that none of them holds is never repaired (heading noise alone:
+  docs/experiments/Sweeper-v1.md); a bump leaves it where it was, and weighs down
   the particles whose move would have found a footprint the map holds free
   (``exp(-BLOCKED)``).
 - **Weight.** Over the window's cells sensed now (``known``; all in v0)
@@ -49,6 +53,7 @@ from motiongym.envs.sweeper.maps import MAX_SIDE
 MISMATCH = 0.5  # log-weight per window cell that disagrees with the map
 BLOCKED = 4.0  # log-weight per map obstacle under the footprint
 MAX_SLIP = 1.4  # the environment's longest move (cells)
+MIN_SLIP = 0.05  # the particles' slip std at least (roughening; see the module docstring)
 
 
 class Localiser:
@@ -65,7 +70,7 @@ class Localiser:
         self, w: int, R: int, heading_noise: float, slip_noise: float, n: int = 256, seed: int = 0
     ) -> None:
         self.w, self.R, self.S = w, R, w + 2 * R
-        self.sh, self.ss, self.n = heading_noise, slip_noise, n
+        self.sh, self.ss, self.n = heading_noise, max(slip_noise, MIN_SLIP), n
         self.rng = np.random.default_rng(seed)
         # (n,) particle states (row, column, heading error), set at the first observation
         self.y: np.ndarray = np.zeros(0)
