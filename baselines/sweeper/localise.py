@@ -19,10 +19,16 @@ The rules:
 
 - **Motion** (the environment's odometry model, with its noise levels
   known to the robot as its odometry spec): every action adds
-  ``N(0, heading_noise)`` to each particle's ``e``; a forward move that the
-  dead-reckoned pose shows made (no bump) moves each particle
-  ``d ~ N(1, slip_noise)`` (clipped to ``[0, 1.4]``) along the commanded
-  heading turned by ``e``; a bump leaves it where it was, and weighs down
+  ``N(0, heading_noise)`` to each particle's ``e``; a forward move (the
+  heading unchanged, as a turn always changes it, and no bump; not the
+  dead-reckoned pose changing, which the environment clips to the map's
+  extent, so that a drifted reckoning hides moves) moves each particle
+  ``d ~ N(1, max(slip_noise, 0.05))`` (clipped to ``[0, 1.4]``) along the
+  commanded heading turned by ``e``; the floor is roughening (Gordon,
+  Salmond & Smith 1993): with exact moves the particles differ only by
+  their heading error, resampling leaves a few tracks, and a pose error
+  that none of them holds is never repaired (heading noise alone:
+  docs/experiments/Sweeper-v1.md); a bump leaves it where it was, and weighs down
   the particles whose move would have found a footprint the map holds free
   (``exp(-BLOCKED)``).
 - **Weight.** Over the window's cells sensed now (``known``; all in v0)
@@ -47,6 +53,7 @@ from motiongym.envs.sweeper.maps import MAX_SIDE
 MISMATCH = 0.5  # log-weight per window cell that disagrees with the map
 BLOCKED = 4.0  # log-weight per map obstacle under the footprint
 MAX_SLIP = 1.4  # the environment's longest move (cells)
+MIN_SLIP = 0.05  # the particles' slip std at least (roughening; see the module docstring)
 
 
 class Localiser:
@@ -63,7 +70,7 @@ class Localiser:
         self, w: int, R: int, heading_noise: float, slip_noise: float, n: int = 256, seed: int = 0
     ) -> None:
         self.w, self.R, self.S = w, R, w + 2 * R
-        self.sh, self.ss, self.n = heading_noise, slip_noise, n
+        self.sh, self.ss, self.n = heading_noise, max(slip_noise, MIN_SLIP), n
         self.rng = np.random.default_rng(seed)
         # (n,) particle states (row, column, heading error), set at the first observation
         self.y: np.ndarray = np.zeros(0)
@@ -71,6 +78,7 @@ class Localiser:
         self.e: np.ndarray = np.zeros(0)
         self.wt = np.full(n, 1.0 / n)
         self.reckoned: tuple[int, int] | None = None  # the last dead-reckoned cell
+        self.heading = 0  # the last observed (commanded) heading
         self.cell = (0, 0)
 
     def locate(self, robot_map: RobotMap, obs: dict) -> tuple[int, int]:
@@ -79,13 +87,15 @@ class Localiser:
         reckoned = int(round(float(pose[0]))), int(round(float(pose[1])))
         h = int(round(float(pose[2])))
         if self.reckoned is None:  # the first observation: the start is known exactly
-            self.reckoned, self.cell = reckoned, reckoned
+            self.reckoned, self.cell, self.heading = reckoned, reckoned, h
             self.y = np.full(self.n, float(reckoned[0]))
             self.x = np.full(self.n, float(reckoned[1]))
             self.e = np.zeros(self.n)
             return self.cell
-        self._move(reckoned != self.reckoned, h)
-        self.reckoned = reckoned
+        # a forward move that did not bump: the heading is unchanged (a turn always changes
+        # it) and no bump; the dead-reckoned cell is no witness, as it is clipped to the map
+        self._move(h == self.heading and pose[3] <= 0.5, h)
+        self.reckoned, self.heading = reckoned, h
         if pose[3] > 0.5:
             self._felt(robot_map, h)
         self._weigh(robot_map, obs)

@@ -19,6 +19,10 @@ the map holds no reachable floor unswept or unknown: a bump is not taken as
 proof of a wall at that point (the felt marks are dropped and the map looked
 at again), and a scan that finds the same leftovers as the last one sends
 the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
+A bump where the map holds the footprint ahead free (the continuous pose,
+drifted by the heading error, rounds into the wall beside the path) sends
+the robot one cell sideways, against the estimated drift, and its bump
+marks become unknown, not walls, once it has moved on.
 :class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
 dead-reckoned pose; :class:`PsaCwaBfsTransferPolicy` the one that moves
 between runs along the shortest path over all known free configurations
@@ -108,6 +112,7 @@ class PsaCwaPolicy(ScriptedPolicy):
     localise = True  # correct the pose by scan matching when the odometry is noisy
     max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
     evidence = EVIDENCE  # map votes when localising (0: the latest window wins)
+    sidestep = True  # localising: step aside after a bump the map does not explain
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -152,10 +157,15 @@ class PsaCwaPolicy(ScriptedPolicy):
             m.run_heading, m.run_side = h, psa.right_of(h)
             m.lane_start = (r, c)
         if bump:  # the cells ahead are blocked, whatever the map said
+            unexplained = m.loc is not None and self.sidestep and self._ahead_free(m, r, c, h)
             self._mark_ahead(m, r, c, h)
             m.path.clear()
+            if unexplained:
+                self._sidestep(m, r, c, h)
         elif (r, c) != m.last_pose and m.map.felt.any():
-            m.map.forget_felt()  # moved on: bump marks were for where it stood
+            # moved on: bump marks were for where it stood (localising: unknown until seen
+            # again, so that a bump the map did not explain leaves no wall behind)
+            m.map.forget_felt(unmark=m.loc is not None and self.sidestep)
         m.last_pose = (r, c)
         for _ in range(200):
             a = self._follow(m, r, c, h)
@@ -165,6 +175,30 @@ class PsaCwaPolicy(ScriptedPolicy):
             if a is not None:
                 return a
         return LEFT  # pragma: no cover - a planning loop that does not settle
+
+    def _ahead_free(self, m: Memory, r: int, c: int, h: int) -> bool:
+        """True when the map holds no obstacle in the footprint one move ahead."""
+        occ, _ = m.map.footprint(r + int(DR[h]), c + int(DC[h]))
+        return not (occ == OBSTACLE).any()
+
+    def _sidestep(self, m: Memory, r: int, c: int, h: int) -> None:
+        """After a bump the map does not explain: one cell sideways, against the drift.
+
+        The true heading is ``h`` turned by the heading error ``e``, so a move
+        drifts to the left of ``h`` when ``e > 0``; the robot's continuous
+        position can sit just short of the next cell across, and every move
+        ahead then rounds into the wall beside the path (the same bump for
+        ever). A step to the side away from the drift (the localiser's
+        weighted mean ``e``) takes it off that line.
+        """
+        e = float(np.average(m.loc.e, weights=m.loc.wt)) if m.loc is not None else 0.0
+        first = psa.right_of(h) if e > 0 else psa.left_of(h)
+        for s in (first, (first + 2) % 4):
+            cell = (r + int(DR[s]), c + int(DC[s]))
+            occ, _ = m.map.footprint(*cell)
+            if not (occ == OBSTACLE).any():
+                m.path = deque([cell])
+                return
 
     def _mark_ahead(self, m: Memory, r: int, c: int, h: int) -> None:
         rr, cc = np.nonzero(occupancy.entering_mask(int(DR[h]), int(DC[h]), self.w))
