@@ -161,9 +161,8 @@ def test_a_tiny_sweep_on_a_local_ray_writes_run_folders_and_ship_commands(
 @pytest.mark.slow
 @pytest.mark.parametrize(
     ("env_id", "multi_agent"),
-    [("motiongym/Sweeper-v0", False), ("motiongym/HarvestArmPlanar-v0", False),
-     ("motiongym/DualArmCell-v0", True)],
-)  # fmt: skip
+    [(env_id, False) for env_id in ENV_IDS] + [("motiongym/DualArmCell-v0", True)],
+)  # every ID with RLlib's PPO, the dual-arm cell also as RLlib multi-agent
 def test_one_tiny_rllib_iteration(tmp_path, local_ray, env_id, multi_agent):
     from motiongym.agents.rllib_runs import train_rllib
 
