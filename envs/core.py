@@ -216,24 +216,12 @@ def reward_and_info(
     return add_reward_terms(info, terms), info
 
 
-class _RewardKeys(dict):
-    """term -> ``"reward_<term>"``, each made once (on its first use)."""
-
-    def __missing__(self, term: str) -> str:
-        key = self[term] = f"reward_{term}"
-        return key
-
-
-_REWARD_KEYS = _RewardKeys()
-
-
 def add_reward_terms(info: dict[str, Any], terms: Mapping[str, float]) -> float:
     """Write ``reward_<term>`` for every term into ``info``; return the reward (their
     sum, in their order). For a step that builds its ``info`` itself, in the layout of
     :func:`reward_and_info`."""
-    keys = _REWARD_KEYS
     for key, value in terms.items():
-        info[keys[key]] = float(value)
+        info[f"reward_{key}"] = float(value)
     return float(sum(terms.values()))
 
 
