@@ -11,6 +11,7 @@ from motiongym.agents.evaluate import run_episode
 from motiongym.baselines.sweeper.belief import RobotMap
 from motiongym.baselines.sweeper.localise import Localiser
 from motiongym.baselines.sweeper.psa_cwa import PsaCwaDeadReckoningPolicy, PsaCwaPolicy
+from motiongym.envs.sweeper import generator
 
 ENV_ID = "motiongym/Sweeper-v1"
 NOISE = {"heading_noise": 0.01, "slip_noise": 0.05}
@@ -45,6 +46,46 @@ def office() -> np.ndarray:
         g[23, c0 + 2 : c0 + 7] = False
     g[6:9, 4:9] = g[30:33, 30:35] = True
     return g
+
+
+def corridors() -> np.ndarray:
+    """Six corridors 4-7 cells wide, joined end to end by 5-wide gaps (a serpentine)."""
+    g = np.zeros((44, 50), bool)
+    g[0, :] = g[-1, :] = g[:, 0] = g[:, -1] = True
+    r = 0
+    for i, width in enumerate((4, 5, 6, 4, 7, 5)):
+        r += width + 1
+        if r >= 43:
+            break
+        g[r, :] = True
+        g[r, 1:6] = False if i % 2 else g[r, 1:6]
+        g[r, -6:-1] = g[r, -6:-1] if i % 2 else False
+    return g
+
+
+def pillars() -> np.ndarray:
+    """A hall with a 4 x 4 grid of 2 x 2 pillars (periodic: every pillar looks alike)."""
+    g = np.zeros((40, 46), bool)
+    g[0, :] = g[-1, :] = g[:, 0] = g[:, -1] = True
+    for r in range(7, 36, 9):
+        for c in range(7, 42, 10):
+            g[r : r + 2, c : c + 2] = True
+    return g
+
+
+def procedural(seed: int, kind: str):
+    """A map of the training generator from a seed no test or study used before."""
+    return lambda: generator.random_map(np.random.default_rng(seed), 3, kind)
+
+
+UNSEEN = {"L": l_shape, "office": office, "spiral": spiral}
+NEW_UNSEEN = {
+    "corridors": corridors,
+    "pillars": pillars,
+    "apartment 4242": procedural(4242, "apartment"),
+    "room 4243": procedural(4243, "room"),
+    "maze 4244": procedural(4244, "maze"),
+}
 
 
 def coverage_at_done(cls, seed: int, **kwargs) -> tuple[float, bool]:
@@ -127,6 +168,24 @@ def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
             )
     assert np.mean(ours) > np.mean(ablation) + 0.1
     assert np.min(ours) > np.min(ablation)
+
+
+@pytest.mark.slow
+def test_localised_beats_dead_reckoning_on_new_unseen_maps() -> None:
+    """Corridors, pillars, generator maps from fresh seeds (apartment 4242, room 4243,
+    maze 4244), seeds 0-1, heading 0.01 + slip 0.05. Measured, coverage at done:
+    localised 97.6 % mean, 91.4 % min; dead reckoning 80.6 %, 8.6 %. Seeds 0-6 of
+    these five maps and the L, office and spiral (56 runs): 98.4 % mean, 86.1 % min
+    (docs/experiments/Sweeper-v1.md, third pass); the issue's 99 / 97 % is not met."""
+    ours, ablation = [], []
+    for make in NEW_UNSEEN.values():
+        for seed in range(2):
+            ours.append(coverage_at_done(PsaCwaPolicy, seed, grid=make(), **NOISE)[0])
+            ablation.append(
+                coverage_at_done(PsaCwaDeadReckoningPolicy, seed, grid=make(), **NOISE)[0]
+            )
+    assert np.mean(ours) > 0.97 and np.min(ours) > 0.9
+    assert np.mean(ours) > np.mean(ablation) + 0.1
 
 
 class NoVotes(PsaCwaPolicy):
