@@ -259,6 +259,7 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         self._tracks_box = bodies.machine_bodies(
             origin, 0.0, self.rotation, self.m.bucket_width, self.m.L0, ("tracks",)
         )["tracks"]
+        self._tracks_sphere = self._tracks_box.sphere()
 
     # ------------------------------------------------------------------ step
     def advance(self, values: list[float]) -> None:
