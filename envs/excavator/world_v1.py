@@ -265,11 +265,12 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def advance(self, values: list[float]) -> None:
         m, dt = self.m, self.dt
         q0 = self.q
-        rates = hydraulic_rates(values, self.qdot, m, dt)
-        target = []
-        for a, r, (lo, hi) in zip(q0, rates, self._limits, strict=True):
-            new = a + r * dt
-            target.append(lo if new < lo else hi if new > hi else new)
+        r0, r1, r2, r3 = hydraulic_rates(values, self.qdot, m, dt)
+        target = [q0[0] + r0 * dt, q0[1] + r1 * dt, q0[2] + r2 * dt, q0[3] + r3 * dt]
+        for k, (lo, hi) in enumerate(self._limits):  # held in the joint ranges
+            new = target[k]
+            if new < lo or new > hi:
+                target[k] = lo if new < lo else hi
         pose0, pose1 = self._pose_now, Pose(target, self)
         depth1 = self._edge_depth(pose1)
         cutting = False
@@ -293,7 +294,12 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         self.ground_contact = 1.0 if body_stop else 0.0
         self.advance_fraction = t
         self.q = q = list(pose.q)
-        self.qdot = [(a - b) / dt for a, b in zip(q, q0, strict=True)]
+        self.qdot = [
+            (q[0] - q0[0]) / dt,
+            (q[1] - q0[1]) / dt,
+            (q[2] - q0[2]) / dt,
+            (q[3] - q0[3]) / dt,
+        ]
         self._set_pose(pose)
         self.steps += 1
         self.elapsed = self.steps * dt
