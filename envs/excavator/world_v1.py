@@ -36,7 +36,6 @@ stopped a part other than the cutting edge) is reported, not ended on.
 
 from __future__ import annotations
 
-import functools
 import math
 from math import cos, sin
 
@@ -114,7 +113,7 @@ class Pose:
         foot = (fx, fy, d1)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
         if world.rotation is not None:  # R v for each point and axis
-            rot = world._turn
+            rot = world._rot
             foot, p1, p2, tip, n, u, lat = (
                 rot(foot),
                 rot(p1),
@@ -182,7 +181,7 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def reset(self, scene, q0) -> None:
         base = tuple(scene.base)
         self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
-        self._turn = _rotator(self.rotation)
+        self._rows = None if self.rotation is None else tuple(sum(self.rotation, []))
         m = self.m
         self._links = (m.L0, m.L1, m.d1, m.d2, m.L2, m.L3, m.L4)
         self.self_clear = math.inf
@@ -361,8 +360,10 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
 
     # --------------------------------------------------------------- physics
     def _rot(self, v) -> tuple[float, float, float]:
-        """``R v``: a vector of frame M in frame O (the base rotation)."""
-        return self._turn(v)
+        """``R v``: a vector of frame M in frame O (the base rotation, rows flat in ``_rows``)."""
+        a, b, c, d, e, f, g, h, i = self._rows
+        x, y, z = v
+        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
 
     def _pose(self, q) -> Pose:
         return Pose(q, self)
@@ -476,19 +477,6 @@ def _floats(value):
         items = [_floats(v) for v in value]
         return type(value)(*items) if hasattr(value, "_fields") else tuple(items)
     return float(value)
-
-
-def _rotator(rotation):
-    """``v -> R v`` for the rows of ``rotation`` (None: level, no rotation is applied);
-    a partial of :func:`_turn` (picklable, as the environments are)."""
-    if rotation is None:
-        return None
-    return functools.partial(_turn, *rotation[0], *rotation[1], *rotation[2])
-
-
-def _turn(a, b, c, d, e, f, g, h, i, v) -> tuple[float, float, float]:
-    x, y, z = v
-    return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
 
 
 def _lerp(a, b, t: float) -> list[float]:
