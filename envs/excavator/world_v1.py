@@ -166,12 +166,19 @@ class Pose:
             (pin, pin, bodies.STICK_RADIUS),
         ):
             out.append((0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) - r))
-        u, n, lat = self.u, self.n, self.lat
+        (ux, uy, uz), (nx, ny, nz), (lx, ly, lz) = self.u, self.n, self.lat
         side = 0.5 * m.bucket_width - SHELL_INSET
+        px, py, pz = pin
         for along, back in SHELL:
             a = along * m.L4
-            for s in (side, -side):
-                out.append(tuple(pin[i] + a * u[i] - back * n[i] + s * lat[i] for i in range(3)))
+            for s in (side, -side):  # pin + a u - back n + s lat
+                out.append(
+                    (
+                        px + a * ux - back * nx + s * lx,
+                        py + a * uy - back * ny + s * ly,
+                        pz + a * uz - back * nz + s * lz,
+                    )
+                )
         return out
 
 
