@@ -151,13 +151,11 @@ class Pose:
         m, rot = world.m, world._rot if world.rotation is not None else None
         c1, s1 = self.c1, self.s1
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
-        out = [
-            (x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0)
-            for x in bodies.HOUSE[0]
-            for y in bodies.HOUSE[1]
-        ]
-        if rot is not None:
-            out = [rot(p) for p in out]
+        out = []
+        for x in bodies.HOUSE[0]:
+            for y in bodies.HOUSE[1]:
+                p = (x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0)
+                out.append(p if rot is None else rot(p))
         foot, stick_pin, pin, _ = self.points
         for a, b, r in (
             (foot, stick_pin, bodies.BOOM_RADIUS),
