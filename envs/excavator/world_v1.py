@@ -113,16 +113,7 @@ class Pose:
         foot = (fx, fy, d1)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
         if world.rotation is not None:  # R v for each point and axis
-            rot = world._rot
-            foot, p1, p2, tip, n, u, lat = (
-                rot(foot),
-                rot(p1),
-                rot(p2),
-                rot(tip),
-                rot(n),
-                rot(u),
-                rot(lat),
-            )
+            foot, p1, p2, tip, n, u, lat = world._rot_all((foot, p1, p2, tip, n, u, lat))
         self.points, self.tip, self.beta = (foot, p1, p2, tip), tip, beta
         self.n, self.u, self.lat = n, u, lat
         half = world._edge_half
@@ -369,6 +360,14 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         a, b, c, d, e, f, g, h, i = self._rows
         x, y, z = v
         return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+
+    def _rot_all(self, vectors) -> list[tuple[float, float, float]]:
+        """:meth:`_rot` of each of ``vectors`` (one call for a pose's points and axes)."""
+        a, b, c, d, e, f, g, h, i = self._rows
+        out = []
+        for x, y, z in vectors:
+            out.append((a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z))
+        return out
 
     def _pose(self, q) -> Pose:
         return Pose(q, self)
