@@ -139,14 +139,15 @@ class Pose:
     def under(self) -> list[tuple[float, float, float]]:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
         world = self._world
-        m, rot = world.m, world._rot if world.rotation is not None else None
+        m = world.m
         c1, s1 = self.c1, self.s1
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
         out = []
         for x in bodies.HOUSE[0]:
             for y in bodies.HOUSE[1]:
-                p = (x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0)
-                out.append(p if rot is None else rot(p))
+                out.append((x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0))
+        if world.rotation is not None:
+            out = world._rot_all(out)
         foot, stick_pin, pin, _ = self.points
         for a, b, r in (
             (foot, stick_pin, bodies.BOOM_RADIUS),
@@ -355,14 +356,9 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         return self.terrain.volume() + (self.fill + self.truck_soil) / self.m.swell
 
     # --------------------------------------------------------------- physics
-    def _rot(self, v) -> tuple[float, float, float]:
-        """``R v``: a vector of frame M in frame O (the base rotation, rows flat in ``_rows``)."""
-        a, b, c, d, e, f, g, h, i = self._rows
-        x, y, z = v
-        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
-
     def _rot_all(self, vectors) -> list[tuple[float, float, float]]:
-        """:meth:`_rot` of each of ``vectors`` (one call for a pose's points and axes)."""
+        """``R v`` for each of ``vectors``: frame M to frame O (the base rotation, its rows
+        flat in ``_rows``); one call for all of a pose's points and axes."""
         a, b, c, d, e, f, g, h, i = self._rows
         out = []
         for x, y, z in vectors:
@@ -393,7 +389,8 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         if memo[0] is t and memo[1] == t.version:
             return memo[2]
         h = t.height_at
-        depth = max(h(p[0], p[1]) - p[2] for p in pose.edge())
+        a, b, c = pose.edge()
+        depth = max(h(a[0], a[1]) - a[2], h(b[0], b[1]) - b[2], h(c[0], c[1]) - c[2])
         pose.edge_memo = (t, t.version, depth)
         return depth
 
