@@ -63,7 +63,7 @@ class ClearancesV1:
     _swing_axis: bodies.Vec
     _up: bodies.Vec
     _tracks_box: Any  # the tracks' body (bodies.machine_bodies)
-    _tracks_sphere: tuple[bodies.Vec, float]  # its bounding sphere (centre, radius)
+    _tracks_sphere: tuple[tuple[float, float, float], float]  # its bounding sphere (centre, radius)
 
     def _clearances(self) -> None:
         """Exact body distances below the horizons, lower bounds above.

@@ -178,7 +178,10 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def reset(self, scene, q0) -> None:
         base = tuple(scene.base)
         self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
-        self._rows = None if self.rotation is None else tuple(sum(self.rotation, []))
+        # R's rows flat (empty on level ground, where nothing is turned)
+        self._rows: tuple[float, ...] = (
+            () if self.rotation is None else tuple(sum(self.rotation, []))
+        )
         m = self.m
         self._links = (m.L0, m.L1, m.d1, m.d2, m.L2, m.L3, m.L4)
         self.self_clear = math.inf
