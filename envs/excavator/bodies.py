@@ -109,7 +109,11 @@ class Box(NamedTuple):
     def world(self, u: float, v: float, w: float) -> Vec:
         a0, a1, a2 = self.axes
         c = self.centre
-        return tuple(c[i] + u * a0[i] + v * a1[i] + w * a2[i] for i in range(3))
+        return (
+            c[0] + u * a0[0] + v * a1[0] + w * a2[0],
+            c[1] + u * a0[1] + v * a1[1] + w * a2[1],
+            c[2] + u * a0[2] + v * a1[2] + w * a2[2],
+        )
 
     def corners(self) -> list[Vec]:
         hx, hy, hz = self.half
@@ -252,7 +256,7 @@ def sphere_gap(p, q) -> float:
 def bucket_box(pin: Vec, tip: Vec, lateral: Vec, width: float) -> Box:
     """The bucket's body: ``u`` = pin to tip, ``-n`` = ``lateral x u`` (behind the opening)."""
     length = math.dist(pin, tip)
-    u = tuple((t - p) / length for p, t in zip(pin, tip, strict=True))
+    u = ((tip[0] - pin[0]) / length, (tip[1] - pin[1]) / length, (tip[2] - pin[2]) / length)
     back = _cross(lateral, u)
     ranges = (
         (-0.15, length + 0.05),
@@ -318,5 +322,9 @@ def house_box(axis: Vec, up: Vec, c1: float, s1: float, rotation) -> Box:
 def _apply(rotation):
     if rotation is None:
         return lambda v: v
-    r = rotation
-    return lambda v: tuple(r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2] for i in range(3))
+    (a, b, c), (d, e, f), (g, h, i) = rotation
+    return lambda v: (
+        a * v[0] + b * v[1] + c * v[2],
+        d * v[0] + e * v[1] + f * v[2],
+        g * v[0] + h * v[1] + i * v[2],
+    )

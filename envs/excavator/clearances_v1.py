@@ -63,6 +63,7 @@ class ClearancesV1:
     _swing_axis: bodies.Vec
     _up: bodies.Vec
     _tracks_box: Any  # the tracks' body (bodies.machine_bodies)
+    _tracks_sphere: tuple[tuple[float, float, float], float]  # its bounding sphere (centre, radius)
 
     def _clearances(self) -> None:
         """Exact body distances below the horizons, lower bounds above.
@@ -83,15 +84,14 @@ class ClearancesV1:
         z0, z1, z2, z3 = pts[0][2], pts[1][2], pts[2][2], pts[3][2]
         lows = (z1 if z1 < z0 else z0, z2 if z2 < z1 else z1, z3 if z3 < z2 else z2)
         cache: dict = {}
-        to_truck, to_axis = _plan_gaps(pts, self._truck_centre, self._axis)
         top = self._pipe_top
         d0, d1, d2 = lows[0] - REACH[0] - top, lows[1] - REACH[1] - top, lows[2] - REACH[2] - top
         if d0 >= HORIZON and d1 >= HORIZON and d2 >= HORIZON:  # far: the bounds stand
             self.pipe_clear = d0 if d0 <= d1 and d0 <= d2 else d1 if d1 <= d2 else d2
         else:
             self.pipe_clear = self._pipe_clearance(cache, (d0, d1, d2))
-        self.truck_clear = self._truck_clearance(cache, lows, to_truck)
-        self.self_clear = self._self_clearance(cache, lows, to_axis)
+        self.truck_clear = self._truck_clearance(cache, lows)
+        self.self_clear = self._self_clearance(cache, lows)
 
     def _pipe_clearance(self, cache: dict, bounds) -> float:
         """The pipe clearance from the parts' bounds ``bounds`` (one under ``HORIZON``)."""
@@ -106,8 +106,13 @@ class ClearancesV1:
                 best = d
         return best
 
-    def _truck_clearance(self, cache: dict, lows, plan) -> float:
-        """The house (its fixed bound, then its sphere's), then boom, stick and bucket."""
+    def _truck_clearance(self, cache: dict, lows) -> float:
+        """The house (its fixed bound, then its sphere's), then boom, stick and bucket.
+
+        A link's bound is its plan-view gap or its height over the rim, whichever
+        is larger; the height alone (no plan view) already leaves out a part
+        ``SKIP`` or more above the smallest value so far.
+        """
         box, best = self._truck_body, self._house_truck
         if best < SELF_HORIZON:
             c, r = self._sphere(cache, "house")
@@ -115,9 +120,12 @@ class ClearancesV1:
             if best < SELF_HORIZON:
                 best = self._box_distance(cache, "house", box, SELF_HORIZON, math.inf)
         radius, height, pts = self._truck_radius, self._truck_height, self.points
+        cx, cy = self._truck_centre
         for k in range(3):
-            gap, above = plan[k] - radius, lows[k] - height
-            reach = REACH[k]
+            above, reach = lows[k] - height, REACH[k]
+            if above - reach - best >= SKIP:  # d >= above - reach: not the smallest
+                continue
+            gap = _segment_gap(cx, cy, pts[k], pts[k + 1]) - radius
             d = (above if above > gap else gap) - reach
             if d < HORIZON:
                 if d - best >= SKIP:
@@ -133,32 +141,52 @@ class ClearancesV1:
                 best = d
         return best
 
-    def _self_clearance(self, cache: dict, lows, plan) -> float:
-        """Bucket, then stick, against tracks and house (the bucket's cheap bounds first)."""
-        best, top, horizon = math.inf, self._house_top, SELF_HORIZON
-        gap, above = plan[1] - HOUSE_RADIUS, lows[2] - top
-        d = (above if above > gap else gap) - UNDER_REACH
-        if d >= horizon:
-            best = d
-        else:  # the bucket: its sphere's bound first
-            (x, y, z), r = self._sphere(cache, "bucket")
-            slack = self._bucket_slack
-            for other in (self._tracks_box, self._part(cache, "house")):
-                d = other.gap((x, y, z)) - r
-                if d < horizon and d - slack - best < SKIP:
-                    d = self._box_distance(cache, "bucket", other, horizon, best)
-                if d < best:
-                    best = d
-        gap, above = plan[0] - HOUSE_RADIUS, lows[1] - top
-        d = (above if above > gap else gap) - REACH[1]
-        if d >= horizon:
-            return d if d < best else best
-        if d - best < SKIP:  # the stick's capsule against each box
-            pts, reach = self.points, REACH[1]
-            for other in (self._tracks_box, self._part(cache, "house")):
-                d = bodies.segment_to_box(pts[1], pts[2], other, best + reach) - reach
-                if d < best:
-                    best = d
+    def _self_clearance(self, cache: dict, lows) -> float:
+        """Bucket, then stick, against tracks and house (the bucket's cheap bounds first).
+
+        The stick's bound comes first: over the horizon it is the stick's
+        value, and it can leave out the bucket's bodies; the tracks' and the
+        house's boxes are visited only where their spheres' bound could be
+        the smallest.
+        """
+        top, horizon, (ax, ay), pts = self._house_top, SELF_HORIZON, self._axis, self.points
+        above = lows[1] - top
+        gap = _segment_gap(ax, ay, pts[1], pts[2]) - HOUSE_RADIUS
+        stick = (above if above > gap else gap) - REACH[1]
+        best = stick if stick >= horizon else math.inf  # the stick's value
+        above = lows[2] - top
+        if above - UNDER_REACH - best < SKIP:  # else the bucket's bound is not the smallest
+            gap = _segment_gap(ax, ay, pts[2], pts[3]) - HOUSE_RADIUS
+            d = (above if above > gap else gap) - UNDER_REACH
+            if d >= horizon:
+                best = d if d < best else best
+            else:  # the bucket: its sphere's bounds first
+                best = self._bucket_self(cache, best)
+        if stick >= horizon or stick - best >= SKIP:
+            return best
+        reach = REACH[1]  # the stick's capsule against each box
+        for other in (self._tracks_box, self._part(cache, "house")):
+            d = bodies.segment_to_box(pts[1], pts[2], other, best + reach) - reach
+            if d < best:
+                best = d
+        return best
+
+    def _bucket_self(self, cache: dict, best: float) -> float:
+        """The bucket against the tracks and the house (``best``: the smallest value so
+        far); a box whose sphere is ``SKIP`` or more farther than ``best`` is left out."""
+        c, r = self._sphere(cache, "bucket")
+        slack, horizon = self._bucket_slack, SELF_HORIZON
+        for name in ("tracks", "house"):
+            (x, y, z), radius = self._sphere(cache, name)
+            x, y, z = c[0] - x, c[1] - y, c[2] - z
+            if math.sqrt(x * x + y * y + z * z) - radius - r - slack - best >= SKIP:
+                continue  # the spheres' gap: this box is farther than best
+            box = self._part(cache, name)
+            d = box.gap(c) - r
+            if d < horizon and d - slack - best < SKIP:
+                d = self._box_distance(cache, "bucket", box, horizon, best)
+            if d < best:
+                best = d
         return best
 
     def _exact(self, cache: dict, name: str, other, gap, horizon: float, best=math.inf) -> float:
@@ -216,7 +244,9 @@ class ClearancesV1:
         )
 
     def _sphere(self, cache: dict, name: str) -> tuple[tuple[float, float, float], float]:
-        """Bounding sphere ``(centre, radius)`` of the bucket's or the house's body."""
+        """Bounding sphere ``(centre, radius)`` of the bucket's, the house's or the tracks' body."""
+        if name == "tracks":
+            return self._tracks_sphere
         key = _SPHERE_KEYS[name]
         if key in cache:
             return cache[key]
@@ -245,21 +275,10 @@ class ClearancesV1:
 _SPHERE_KEYS = {"bucket": "bucket sphere", "house": "house sphere"}  # in a step's cache
 
 
-def _plan_gaps(pts, p, q) -> tuple[tuple[float, ...], tuple[float, float]]:
-    """Plan-view distances from the point ``p`` to the arm's three segments (boom,
-    stick, bucket) and from ``q`` to the last two."""
-    (x0, y0, _), (x1, y1, _), (x2, y2, _), (x3, y3, _) = pts
-    (px, py), (qx, qy) = p, q
-    boom = _plan_gap(px, py, x0, y0, x1 - x0, y1 - y0)
-    dx, dy = x2 - x1, y2 - y1
-    stick, stick_q = _plan_gap(px, py, x1, y1, dx, dy), _plan_gap(qx, qy, x1, y1, dx, dy)
-    dx, dy = x3 - x2, y3 - y2
-    bucket, bucket_q = _plan_gap(px, py, x2, y2, dx, dy), _plan_gap(qx, qy, x2, y2, dx, dy)
-    return (boom, stick, bucket), (stick_q, bucket_q)
-
-
-def _plan_gap(x: float, y: float, ax: float, ay: float, dx: float, dy: float) -> float:
-    """Plan-view distance from ``(x, y)`` to the segment from ``(ax, ay)`` along ``(dx, dy)``."""
+def _segment_gap(x: float, y: float, a, b) -> float:
+    """Plan-view distance from ``(x, y)`` to the segment ``a b`` (points, z ignored)."""
+    ax, ay = a[0], a[1]
+    dx, dy = b[0] - ax, b[1] - ay
     px, py = x - ax, y - ay
     length2 = dx * dx + dy * dy
     t = (px * dx + py * dy) / length2 if length2 > 1e-18 else 0.0

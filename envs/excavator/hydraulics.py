@@ -38,8 +38,11 @@ def hydraulic_rates(values, qdot, m, dt: float) -> list[float]:
     demand = sum((abs(c0) / r0 * s0, abs(c1) / r1 * s1, abs(c2) / r2 * s2, abs(c3) / r3 * s3))
     if demand > 1.0:
         c0, c1, c2, c3 = c0 / demand, c1 / demand, c2 / demand, c3 / demand
-    out = []
-    for c, w, a in zip((c0, c1, c2, c3), qdot, m.accel_max, strict=True):
-        step = a * dt
-        out.append(w + step if c - w > step else w - step if w - c > step else c)
-    return out
+    (a0, a1, a2, a3), (w0, w1, w2, w3) = m.accel_max, qdot
+    a0, a1, a2, a3 = a0 * dt, a1 * dt, a2 * dt, a3 * dt  # the most change of a rate
+    return [
+        w0 + a0 if c0 - w0 > a0 else w0 - a0 if w0 - c0 > a0 else c0,
+        w1 + a1 if c1 - w1 > a1 else w1 - a1 if w1 - c1 > a1 else c1,
+        w2 + a2 if c2 - w2 > a2 else w2 - a2 if w2 - c2 > a2 else c2,
+        w3 + a3 if c3 - w3 > a3 else w3 - a3 if w3 - c3 > a3 else c3,
+    ]

@@ -36,7 +36,6 @@ stopped a part other than the cutting edge) is reported, not ended on.
 
 from __future__ import annotations
 
-import functools
 import math
 from math import cos, sin
 
@@ -114,16 +113,7 @@ class Pose:
         foot = (fx, fy, d1)
         n, u, lat = (c1 * sb, s1 * sb, -cb), (c1 * cb, s1 * cb, sb), (s1, -c1, 0.0)
         if world.rotation is not None:  # R v for each point and axis
-            rot = world._turn
-            foot, p1, p2, tip, n, u, lat = (
-                rot(foot),
-                rot(p1),
-                rot(p2),
-                rot(tip),
-                rot(n),
-                rot(u),
-                rot(lat),
-            )
+            foot, p1, p2, tip, n, u, lat = world._rot_all((foot, p1, p2, tip, n, u, lat))
         self.points, self.tip, self.beta = (foot, p1, p2, tip), tip, beta
         self.n, self.u, self.lat = n, u, lat
         half = world._edge_half
@@ -149,16 +139,15 @@ class Pose:
     def under(self) -> list[tuple[float, float, float]]:
         """Points on the undersides of house, boom, stick and bucket shell (O)."""
         world = self._world
-        m, rot = world.m, world._rot if world.rotation is not None else None
+        m = world.m
         c1, s1 = self.c1, self.s1
         x0, z0 = -m.L0, bodies.HOUSE[2][0]
-        out = [
-            (x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0)
-            for x in bodies.HOUSE[0]
-            for y in bodies.HOUSE[1]
-        ]
-        if rot is not None:
-            out = [rot(p) for p in out]
+        out = []
+        for x in bodies.HOUSE[0]:
+            for y in bodies.HOUSE[1]:
+                out.append((x0 + c1 * x - s1 * y, s1 * x + c1 * y, z0))
+        if world.rotation is not None:
+            out = world._rot_all(out)
         foot, stick_pin, pin, _ = self.points
         for a, b, r in (
             (foot, stick_pin, bodies.BOOM_RADIUS),
@@ -167,12 +156,19 @@ class Pose:
             (pin, pin, bodies.STICK_RADIUS),
         ):
             out.append((0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2]) - r))
-        u, n, lat = self.u, self.n, self.lat
+        (ux, uy, uz), (nx, ny, nz), (lx, ly, lz) = self.u, self.n, self.lat
         side = 0.5 * m.bucket_width - SHELL_INSET
+        px, py, pz = pin
         for along, back in SHELL:
             a = along * m.L4
-            for s in (side, -side):
-                out.append(tuple(pin[i] + a * u[i] - back * n[i] + s * lat[i] for i in range(3)))
+            for s in (side, -side):  # pin + a u - back n + s lat
+                out.append(
+                    (
+                        px + a * ux - back * nx + s * lx,
+                        py + a * uy - back * ny + s * ly,
+                        pz + a * uz - back * nz + s * lz,
+                    )
+                )
         return out
 
 
@@ -182,7 +178,10 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     def reset(self, scene, q0) -> None:
         base = tuple(scene.base)
         self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
-        self._turn = _rotator(self.rotation)
+        # R's rows flat (empty on level ground, where nothing is turned)
+        self._rows: tuple[float, ...] = (
+            () if self.rotation is None else tuple(sum(self.rotation, []))
+        )
         m = self.m
         self._links = (m.L0, m.L1, m.d1, m.d2, m.L2, m.L3, m.L4)
         self.self_clear = math.inf
@@ -259,16 +258,18 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         self._tracks_box = bodies.machine_bodies(
             origin, 0.0, self.rotation, self.m.bucket_width, self.m.L0, ("tracks",)
         )["tracks"]
+        self._tracks_sphere = self._tracks_box.sphere()
 
     # ------------------------------------------------------------------ step
     def advance(self, values: list[float]) -> None:
         m, dt = self.m, self.dt
         q0 = self.q
-        rates = hydraulic_rates(values, self.qdot, m, dt)
-        target = []
-        for a, r, (lo, hi) in zip(q0, rates, self._limits, strict=True):
-            new = a + r * dt
-            target.append(lo if new < lo else hi if new > hi else new)
+        r0, r1, r2, r3 = hydraulic_rates(values, self.qdot, m, dt)
+        target = [q0[0] + r0 * dt, q0[1] + r1 * dt, q0[2] + r2 * dt, q0[3] + r3 * dt]
+        for k, (lo, hi) in enumerate(self._limits):  # held in the joint ranges
+            new = target[k]
+            if new < lo or new > hi:
+                target[k] = lo if new < lo else hi
         pose0, pose1 = self._pose_now, Pose(target, self)
         depth1 = self._edge_depth(pose1)
         cutting = False
@@ -292,7 +293,12 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         self.ground_contact = 1.0 if body_stop else 0.0
         self.advance_fraction = t
         self.q = q = list(pose.q)
-        self.qdot = [(a - b) / dt for a, b in zip(q, q0, strict=True)]
+        self.qdot = [
+            (q[0] - q0[0]) / dt,
+            (q[1] - q0[1]) / dt,
+            (q[2] - q0[2]) / dt,
+            (q[3] - q0[3]) / dt,
+        ]
         self._set_pose(pose)
         self.steps += 1
         self.elapsed = self.steps * dt
@@ -353,9 +359,14 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         return self.terrain.volume() + (self.fill + self.truck_soil) / self.m.swell
 
     # --------------------------------------------------------------- physics
-    def _rot(self, v) -> tuple[float, float, float]:
-        """``R v``: a vector of frame M in frame O (the base rotation)."""
-        return self._turn(v)
+    def _rot_all(self, vectors) -> list[tuple[float, float, float]]:
+        """``R v`` for each of ``vectors``: frame M to frame O (the base rotation, its rows
+        flat in ``_rows``); one call for all of a pose's points and axes."""
+        a, b, c, d, e, f, g, h, i = self._rows
+        out = []
+        for x, y, z in vectors:
+            out.append((a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z))
+        return out
 
     def _pose(self, q) -> Pose:
         return Pose(q, self)
@@ -381,7 +392,8 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         if memo[0] is t and memo[1] == t.version:
             return memo[2]
         h = t.height_at
-        depth = max(h(p[0], p[1]) - p[2] for p in pose.edge())
+        a, b, c = pose.edge()
+        depth = max(h(a[0], a[1]) - a[2], h(b[0], b[1]) - b[2], h(c[0], c[1]) - c[2])
         pose.edge_memo = (t, t.version, depth)
         return depth
 
@@ -469,19 +481,6 @@ def _floats(value):
         items = [_floats(v) for v in value]
         return type(value)(*items) if hasattr(value, "_fields") else tuple(items)
     return float(value)
-
-
-def _rotator(rotation):
-    """``v -> R v`` for the rows of ``rotation`` (None: level, no rotation is applied);
-    a partial of :func:`_turn` (picklable, as the environments are)."""
-    if rotation is None:
-        return None
-    return functools.partial(_turn, *rotation[0], *rotation[1], *rotation[2])
-
-
-def _turn(a, b, c, d, e, f, g, h, i, v) -> tuple[float, float, float]:
-    x, y, z = v
-    return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
 
 
 def _lerp(a, b, t: float) -> list[float]:
