@@ -127,8 +127,8 @@ class ReachPolicy(_ExcavatorPolicy):
         if self.replan:
             error = obs[self.lay["target_error"]]
             height = min(self.FUNNEL_HEIGHT, math.hypot(float(error[0]), float(error[1])))
-            tip = (float(target[0]), float(target[1]), float(target[2]) + height)
-            funnel = bp.Waypoint("funnel", tip, float(target[3]))
+            point = (float(target[0]), float(target[1]), float(target[2]) + height)
+            funnel = bp.Waypoint("funnel", point, float(target[3]))
             memory.update(goals=[self._goal(funnel, q, self._base(obs))], index=0)
         elif memory["goals"] is None:
             base = self._base(obs)
