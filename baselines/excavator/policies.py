@@ -22,6 +22,7 @@ from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.goal import for_goal_env
 from motiongym.baselines.policy import ScriptedPolicy
+from motiongym.envs.core import check_bool
 from motiongym.envs.excavator.kinematics import base_pose, base_rotation
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
 from motiongym.envs.excavator.params import params_for
@@ -74,9 +75,37 @@ class _ExcavatorPolicy(ScriptedPolicy):
 
 
 class ReachPolicy(_ExcavatorPolicy):
-    """IK to the target pose (approached from 1 m above), joint-rate tracking."""
+    """IK to the target pose (approached from 1 m above), joint-rate tracking.
+
+    Args:
+        replan: re-plan from every observation (default False: plan once, at
+            the episode's first observation). The plan made once (1 m above,
+            then the target, the second goal switched to within 0.05 rad of
+            the first) depends on where the episode began and on whether the
+            first goal was reached: a learner that sees only the current
+            observation meets the same state labelled "up" in one episode and
+            "down" in another, and its mean-squared fit averages them to a
+            stall (docs/experiments/ExcavatorReach-v0.md). With ``replan`` the
+            goal is the tip ``h = min(1 m, d)`` above the target, ``d`` the
+            horizontal distance from the tip to it (the approach from above as
+            a funnel: 1 m above while far, down as the tip comes over the
+            target), solved by IK from the current joints at every step: the
+            action is a function of the observation alone, the labels a
+            DAgger learner needs (:mod:`motiongym.agents.dagger`).
+    """
 
     TASK = "reach"
+    FUNNEL_HEIGHT = 1.0  # m: the goal's height above the target while far from it
+
+    def __init__(
+        self,
+        observation_space: spaces.Space,
+        action_space: spaces.Space,
+        env_kwargs: dict[str, Any] | None = None,
+        replan: bool = False,
+    ) -> None:
+        super().__init__(observation_space, action_space, env_kwargs)
+        self.replan = check_bool("replan", replan)
 
     def new_memory(self) -> dict:
         return {"goals": None, "index": 0}
@@ -85,15 +114,24 @@ class ReachPolicy(_ExcavatorPolicy):
         """``planned`` (the IK goals are set) and ``waypoint`` (0: above, 1: target)."""
         return {"planned": memory["goals"] is not None, "waypoint": memory["index"]}
 
+    def _base(self, obs: np.ndarray) -> np.ndarray | None:
+        """The base pose ``H_M^O`` on a slope (v1: the IK takes it; the target is in O)."""
+        if "base" not in self.lay:
+            return None
+        return base_pose(rpy=(*(float(v) for v in obs[self.lay["base"]]), 0.0))
+
     def act(self, observation: np.ndarray, memory: dict) -> np.ndarray:
         obs = np.asarray(observation, dtype=np.float64)
         q = obs[self.lay["q"]]
-        if memory["goals"] is None:
-            # The target tip is in frame O; on a slope (v1) the IK takes the base pose.
-            base = None
-            if "base" in self.lay:
-                base = base_pose(rpy=(*(float(v) for v in obs[self.lay["base"]]), 0.0))
-            target = obs[self.lay["target"]]
+        target = obs[self.lay["target"]]
+        if self.replan:
+            error = obs[self.lay["target_error"]]
+            height = min(self.FUNNEL_HEIGHT, math.hypot(float(error[0]), float(error[1])))
+            point = (float(target[0]), float(target[1]), float(target[2]) + height)
+            funnel = bp.Waypoint("funnel", point, float(target[3]))
+            memory.update(goals=[self._goal(funnel, q, self._base(obs))], index=0)
+        elif memory["goals"] is None:
+            base = self._base(obs)
             tip, beta = target[:3], float(target[3])
             above = bp.Waypoint("above", (tip[0], tip[1], tip[2] + 1.0), beta)
             q_above = self._goal(above, q, base)

@@ -10,9 +10,10 @@ import torch
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluate import evaluate
-from motiongym.agents.features import SweeperEgocentric
+from motiongym.agents.features import ExcavatorFields, SweeperEgocentric
 from motiongym.agents.predictors import load_predictor
 from motiongym.agents.train import train
+from motiongym.envs.excavator.observation import layout
 
 SWEEPER = "motiongym/Sweeper-v0"
 K, S = 16, 9  # the registered coarse resolution and window side (w 3, R 3)
@@ -139,5 +140,36 @@ def test_an_unknown_extractor_name_lists_the_known_ones(tmp_path):
         "ppo:\n  n_timesteps: 10\n  policy: MultiInputPolicy\n"
         "  policy_kwargs: {features_extractor_class: NatureCNN}\n"
     )
-    with pytest.raises(UsageError, match="'NatureCNN' unknown; valid: sweeper_egocentric"):
+    with pytest.raises(
+        UsageError, match="'NatureCNN' unknown; valid: sweeper_egocentric, excavator_fields"
+    ):
         train(SWEEPER, "ppo", config_path=config, out_root=tmp_path)
+
+
+def test_excavator_fields_keep_the_named_entries_and_squash_the_error():
+    """The fields in the order named, unchanged; then tanh(target_error / s) for each scale."""
+    env = gym.make("motiongym/ExcavatorReach-v1")
+    obs = np.stack([env.reset(seed=seed)[0] for seed in range(3)])
+    lay = layout("reach", "v1")
+    extractor = ExcavatorFields(
+        env.observation_space, ["target_error", "q", "base"], physics="v1", error_scales=[0.03, 1]
+    )
+    out = extractor(torch.as_tensor(obs)).numpy()
+    error = obs[:, lay["target_error"]]
+    expected = [error, obs[:, lay["q"]], obs[:, lay["base"]], np.tanh(error / 0.03), np.tanh(error)]
+    assert extractor.features_dim == 4 + 4 + 2 + 8 == out.shape[1]
+    np.testing.assert_allclose(out, np.concatenate(expected, 1), rtol=1e-6, atol=1e-7)
+
+
+def test_excavator_fields_refuse_bad_keywords_by_name():
+    space = gym.make("motiongym/ExcavatorReach-v0").observation_space
+    with pytest.raises(ValueError, match="fields must be names of the reach observation.*'pose'"):
+        ExcavatorFields(space, ["q", "pose"])
+    with pytest.raises(ValueError, match="under physics v1 .shape .60,.., got shape .58,."):
+        ExcavatorFields(space, ["q"], physics="v1")
+    with pytest.raises(ValueError, match="error_scales must be positive numbers.*got .0.1, 0."):
+        ExcavatorFields(space, ["q"], error_scales=[0.1, 0])
+    with pytest.raises(ValueError, match="target_error, got .0.1. for the dig observation"):
+        ExcavatorFields(
+            gym.make("motiongym/Excavator-v0").observation_space, ["q"], "dig", error_scales=[0.1]
+        )
