@@ -161,7 +161,7 @@ def _replace_sections(generated: str, sections: dict[str, str]) -> str:
         start = generated.index(heading)
         end = generated.find("\n### ", start + len(heading))
         end = len(generated) if end < 0 else end + 1
-        generated = generated[:start] + section.rstrip("\n") + "\n" + generated[end:]
+        generated = generated[:start] + section.rstrip("\n") + "\n\n" + generated[end:]
     return generated
 
 
