@@ -151,10 +151,39 @@ def benchmark_section(env_id: str, n_episodes: int, figures: Path, root: Path) -
     return "\n".join(lines)
 
 
-def write_benchmarks(path: Path, n_episodes: int = DEFAULT_EPISODES) -> Path:
-    """Regenerate the tables and figures of ``path`` (``BENCHMARKS.md``)."""
+def _replace_sections(generated: str, sections: dict[str, str]) -> str:
+    """``generated`` (the text between the markers) with each ``### <ID>`` section of
+    ``sections`` replaced (up to the next ``### `` heading); a missing one is an error."""
+    for env_id, section in sections.items():
+        heading = f"### {env_id}\n"
+        if heading not in generated:
+            raise ValueError(f"ids: {env_id} has no section to replace in the generated tables")
+        start = generated.index(heading)
+        end = generated.find("\n### ", start + len(heading))
+        end = len(generated) if end < 0 else end + 1
+        generated = generated[:start] + section.rstrip("\n") + "\n\n" + generated[end:]
+    return generated
+
+
+def write_benchmarks(
+    path: Path, n_episodes: int = DEFAULT_EPISODES, ids: list[str] | None = None
+) -> Path:
+    """Regenerate the tables and figures of ``path`` (``BENCHMARKS.md``); with ``ids``,
+    only those IDs' sections, the others kept as they were."""
     root = path.parent
     figures = root / "docs" / "benchmarks"
+    text = path.read_text() if path.is_file() else f"# Benchmarks\n\n{BEGIN}\n{END}\n"
+    if BEGIN not in text or END not in text:
+        text = f"{text.rstrip()}\n\n{BEGIN}\n{END}\n"
+    head, rest = text.split(BEGIN, 1)
+    generated, tail = rest.split(END, 1)
+    if ids is not None:
+        unknown = [env_id for env_id in ids if env_id not in ENV_IDS]
+        if unknown:
+            raise ValueError(f"ids: {unknown} are not registered IDs ({', '.join(ENV_IDS)})")
+        sections = {i: benchmark_section(i, n_episodes, figures, root) for i in ids}
+        path.write_text(head + BEGIN + _replace_sections(generated, sections) + END + tail)
+        return path
     command = f"motiongym benchmarks --episodes {n_episodes}"
     body = [
         BEGIN,
@@ -165,10 +194,5 @@ def write_benchmarks(path: Path, n_episodes: int = DEFAULT_EPISODES) -> Path:
     ]
     body += [benchmark_section(env_id, n_episodes, figures, root) for env_id in ENV_IDS]
     body.append(END)
-    text = path.read_text() if path.is_file() else f"# Benchmarks\n\n{BEGIN}\n{END}\n"
-    if BEGIN not in text or END not in text:
-        text = f"{text.rstrip()}\n\n{BEGIN}\n{END}\n"
-    head, rest = text.split(BEGIN, 1)
-    tail = rest.split(END, 1)[1]
     path.write_text(head + "\n".join(body) + tail)
     return path

@@ -250,7 +250,11 @@ def cmd_benchmarks(args: argparse.Namespace) -> None:
     from motiongym.agents.benchmarks import write_benchmarks
     from motiongym.agents.report import console
 
-    console.print(f"wrote {write_benchmarks(args.out, n_episodes=args.episodes)}")
+    try:
+        path = write_benchmarks(args.out, n_episodes=args.episodes, ids=args.ids)
+    except ValueError as error:
+        raise UsageError(str(error)) from None
+    console.print(f"wrote {path}")
 
 
 def cmd_reproduce(args: argparse.Namespace) -> None:
@@ -439,6 +443,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     benchmarks.add_argument(
         "--out", type=_file, default=Path("BENCHMARKS.md"), help="file (default BENCHMARKS.md)"
+    )
+    benchmarks.add_argument(
+        "--ids",
+        nargs="+",
+        default=None,
+        help="regenerate only these IDs' sections (default: all)",
     )
     benchmarks.set_defaults(handler=cmd_benchmarks)
 

@@ -38,6 +38,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecNormalize
 
@@ -55,7 +56,7 @@ class DaggerIteration:
     episodes: int
     success: float  # the acting policy's success rate on this iteration's episodes
     label_error: float | None  # mean squared error, learner vs teacher, on the new states,
-    # before the refit (None where the teacher acted)
+    # before the refit (discrete actions: the share that differ; None where the teacher acted)
     states: int  # size of the aggregated data set after this iteration
     loss: float  # the last refit epoch's mean loss
 
@@ -85,24 +86,49 @@ def _rollout(
     return observations, labels, guesses, bool(info.get("is_success", False))
 
 
-def _learner(model: BaseAlgorithm, env: gym.Env, normalization: VecNormalize | None):
-    """The model's deterministic action for one raw observation, within the action box."""
-    if not isinstance(env.action_space, gym.spaces.Box):
-        raise ValueError(f"env must have a Box action space, got {env.action_space}")
-    if not isinstance(env.observation_space, gym.spaces.Box):  # the aggregate is one array
+def _learner(
+    model: BaseAlgorithm,
+    env: gym.Env,
+    normalization: VecNormalize | None,
+    deterministic: bool = True,
+):
+    """The model's action for one raw observation: within the box for a Box action
+    space; for a discrete one, among the environment's allowed actions where it gives
+    masks (MaskablePPO), sampled unless ``deterministic``."""
+    space = env.action_space
+    if not isinstance(space, gym.spaces.Box | gym.spaces.Discrete):
+        raise ValueError(f"env must have a Box or Discrete action space, got {space}")
+    if not isinstance(env.observation_space, gym.spaces.Box | gym.spaces.Dict):
         raise ValueError(
-            f"env must have a Box observation space (the non-goal IDs), got "
+            f"env must have a Box or Dict observation space, got "
             f"{type(env.observation_space).__name__}"
         )
-    low, high = env.action_space.low, env.action_space.high
+    masked = isinstance(model, MaskablePPO)
 
     def act(observation: Any) -> np.ndarray:
         if normalization is not None:
             observation = normalization.normalize_obs(observation)
-        action, _ = model.predict(observation, deterministic=True)
-        return np.clip(action, low, high)
+        kwargs = {"action_masks": env.unwrapped.action_masks()} if masked else {}
+        action, _ = model.predict(observation, deterministic=deterministic, **kwargs)
+        if isinstance(space, gym.spaces.Discrete):
+            return np.asarray(int(action))
+        return np.clip(action, space.low, space.high)
 
     return act
+
+
+def _stacked(observations: list[Any]) -> Any:
+    """The observations as one array, or one array per key (Dict spaces)."""
+    if observations and isinstance(observations[0], dict):
+        return {k: np.stack([o[k] for o in observations]) for k in observations[0]}
+    return np.asarray(observations)
+
+
+def _label_error(guesses: list[np.ndarray], labels: list[np.ndarray], discrete: bool) -> float:
+    """Mean squared error of the learner's actions to the teacher's; for discrete
+    actions, the share of states where they differ."""
+    guess, label = np.asarray(guesses), np.asarray(labels)
+    return float(np.mean(guess != label) if discrete else np.mean((guess - label) ** 2))
 
 
 def on_policy_error(
@@ -136,12 +162,14 @@ def dagger(
     seed: int = DATASET_SEED,
     normalization: VecNormalize | None = None,
     training_seed: int = 0,
+    deterministic: bool = True,
 ) -> list[DaggerIteration]:
     """Teach ``model``'s policy by DAgger; the figures of each iteration (0: cloning).
 
     Args:
         model: an SB3 model whose policy is fitted (``behaviour_clone``).
-        env: a made single environment of the teacher's ID (a Box action space).
+        env: a made single environment of the teacher's ID (a Box or Discrete action
+            space; Box or Dict observations).
         teacher: a predictor with per-episode memory reset by ``episode_start``
             (a scripted policy).
         iterations: learner-acting iterations after the teacher's (0: plain cloning).
@@ -150,10 +178,13 @@ def dagger(
         seed: the first episode's seed.
         normalization: observation statistics, set from iteration 0's states, then frozen.
         training_seed: seeds the refits' minibatch order.
+        deterministic: the learner acts on its most likely action; False: on samples
+            (a run evaluated on sampled actions, ``deterministic: false``).
     """
     check_int("iterations", iterations, 0, 10_000)
     check_int("episodes", episodes, 1, 10**6)
-    learner = _learner(model, env, normalization)
+    learner = _learner(model, env, normalization, deterministic)
+    discrete = isinstance(env.action_space, gym.spaces.Discrete)
     normalize = normalization.normalize_obs if normalization is not None else (lambda o: o)
 
     observations: list[Any] = []
@@ -171,16 +202,19 @@ def dagger(
             guesses += guess
             successes.append(success)
         if iteration == 0 and normalization is not None:
-            normalization.obs_rms.update(np.asarray(new_obs))
+            stacked = _stacked(new_obs)
+            if isinstance(stacked, dict):
+                for key, rms in normalization.obs_rms.items():
+                    rms.update(stacked[key])
+            else:
+                normalization.obs_rms.update(stacked)
             normalization.training = False
-        error = (
-            float(np.mean((np.asarray(guesses) - np.asarray(new_labels)) ** 2)) if guesses else None
-        )
+        error = _label_error(guesses, new_labels, discrete) if guesses else None
         observations += new_obs
         labels += new_labels
         losses = behaviour_clone(
             model,
-            normalize(np.asarray(observations)),
+            normalize(_stacked(observations)),
             np.asarray(labels),
             epochs=epochs,
             seed=training_seed + iteration,

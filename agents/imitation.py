@@ -6,7 +6,12 @@ squared error between the policy's deterministic action and the teacher's,
 in the policy's own action scale (SAC, TQC, TD3 squash to [-1, 1]:
 ``scale_action``; PPO acts with its Gaussian mean), minimised with Adam on
 the network that outputs the action (the ``actor`` of off-policy algorithms,
-the whole policy of on-policy ones). The result is a starting point for RL
+the whole policy of on-policy ones). For a discrete action space (the
+sweeper's MaskablePPO) the loss is the cross-entropy of the teacher's action
+under the policy's distribution (its mean negative log-probability; the mask
+is not applied: the teacher never takes a masked action, and the unmasked
+loss only also moves probability off masked actions, which the mask at
+acting time removes anyway). The result is a starting point for RL
 fine-tuning (``model.learn``), the "from demonstrations" agents of issue 19.
 """
 
@@ -16,6 +21,7 @@ from typing import Any
 
 import numpy as np
 import torch
+from gymnasium import spaces
 from stable_baselines3.common.base_class import BaseAlgorithm
 
 
@@ -31,15 +37,20 @@ def behaviour_clone(
     """Fit ``model``'s policy to ``(observations, actions)``; the mean loss of each epoch.
 
     ``observations``: an array (n, ...) or a dict of them (Dict spaces), as
-    :func:`motiongym.agents.dataset.transitions` returns; ``actions`` (n, k).
+    :func:`motiongym.agents.dataset.transitions` returns; ``actions`` (n, k),
+    or (n,) or (n, 1) integers for a discrete action space.
     """
     policy = model.policy
     n = len(actions)
     count = len(next(iter(observations.values()))) if isinstance(observations, dict) else None
     if (count if count is not None else len(observations)) != n or n == 0:
         raise ValueError(f"observations and actions must have the same length >= 1, got {n}")
-    target = policy.scale_action(actions) if policy.squash_output else np.asarray(actions)
-    target = torch.as_tensor(target, dtype=torch.float32)
+    discrete = isinstance(policy.action_space, spaces.Discrete)
+    if discrete:
+        target = torch.as_tensor(np.asarray(actions).reshape(-1), dtype=torch.long)
+    else:
+        target = policy.scale_action(actions) if policy.squash_output else np.asarray(actions)
+        target = torch.as_tensor(target, dtype=torch.float32)
     network = getattr(policy, "actor", policy)
     optimizer = torch.optim.Adam(network.parameters(), lr=learning_rate)
     rng = np.random.default_rng(seed)
@@ -56,7 +67,10 @@ def behaviour_clone(
                 else observations[rows]
             )
             obs_tensor, _ = policy.obs_to_tensor(batch)
-            loss = torch.nn.functional.mse_loss(policy._predict(obs_tensor, True), target[rows])
+            if discrete:
+                loss = -policy.get_distribution(obs_tensor).log_prob(target[rows]).mean()
+            else:
+                loss = torch.nn.functional.mse_loss(policy._predict(obs_tensor, True), target[rows])
             optimizer.zero_grad()
             loss.backward()
             optimizer.step()

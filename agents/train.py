@@ -200,6 +200,7 @@ def _imitate(env_id: str, config: dict[str, Any], model, venv, seed: int, run_di
         epochs=config["bc_epochs"],
         normalization=venv if isinstance(venv, VecNormalize) else None,
         training_seed=seed,
+        deterministic=config.get("deterministic", True),
     )
     env.close()
     record = {"seconds": time.perf_counter() - started, "iterations": history_json(history)}

@@ -11,7 +11,11 @@ _SWEEPER_POLICIES = {
 # v1's unknown cells unknown until sensed).
 POLICIES: dict[str, dict[str, str]] = {
     "motiongym/Sweeper-v0": dict(_SWEEPER_POLICIES),
-    "motiongym/Sweeper-v1": dict(_SWEEPER_POLICIES),
+    "motiongym/Sweeper-v1": {
+        **_SWEEPER_POLICIES,
+        # a teacher for learned agents (a function of the maps and pose; not the paper's)
+        "nearest-unswept": "motiongym.baselines.sweeper.nearest:NearestUnsweptPolicy",
+    },
 }
 
 # Planning times of `motiongym bench`: label -> ("module:function", goal in s). PSA + CWA

@@ -38,3 +38,23 @@ def test_benchmarks_rewrites_only_the_generated_part(one_shipped_id, tmp_path):
     assert "over 2 or 4 episodes per policy" in generated
     assert (tmp_path / "docs" / "benchmarks" / "ExcavatorReach-v0.png").is_file()
     assert "](docs/benchmarks/ExcavatorReach-v0.png)" in generated
+
+
+def test_benchmarks_ids_rewrites_only_those_sections(one_shipped_id, tmp_path):
+    """``ids``: the named ID's section is regenerated, a neighbour's and the preamble kept;
+    an ID without a section, or not registered, is refused by name."""
+    path = tmp_path / "BENCHMARKS.md"
+    other = "### motiongym/Sweeper-v0\n\nkept table\n"
+    path.write_text(
+        f"{benchmarks.BEGIN}\npreamble\n\n### {ENV_ID}\n\nstale\n\n{other}{benchmarks.END}\n"
+    )
+    benchmarks.write_benchmarks(path, n_episodes=2, ids=[ENV_ID])
+    generated = path.read_text().split(benchmarks.BEGIN)[1].split(benchmarks.END)[0]
+    assert "stale" not in generated and "preamble" in generated and other in generated
+    assert generated.index(f"### {ENV_ID}") < generated.index("newton-raphson-reach")
+    assert generated.index("newton-raphson-reach") < generated.index(other)
+    path.write_text(f"{benchmarks.BEGIN}\n{other}{benchmarks.END}\n")
+    with pytest.raises(ValueError, match="ExcavatorReach-v0 has no section"):
+        benchmarks.write_benchmarks(path, n_episodes=2, ids=[ENV_ID])
+    with pytest.raises(ValueError, match=r"\['Nope-v0'\] are not registered"):
+        benchmarks.write_benchmarks(path, n_episodes=2, ids=["Nope-v0"])
