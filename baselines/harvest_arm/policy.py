@@ -35,7 +35,7 @@ import gymnasium as gym
 import numpy as np
 
 from motiongym.baselines.goal import for_goal_env
-from motiongym.baselines.harvest_arm.potential_field import plan_path
+from motiongym.baselines.harvest_arm.potential_field import field_direction, plan_path
 from motiongym.baselines.harvest_arm.redundancy import limited_rates
 from motiongym.baselines.harvest_arm.reference_velocity import (
     combine,
@@ -110,12 +110,16 @@ class PotentialFieldPolicy(_ArmPolicy):
         link_avoidance: bool = True,
         virtual_plane: bool = True,
         escape: bool | None = None,
+        markov: bool = False,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
+        self.markov = check_bool("markov", markov)
         self.trajectory_following = check_bool("trajectory_following", trajectory_following)
         self.link_avoidance = check_bool("link_avoidance", link_avoidance)
         self.virtual_plane = check_bool("virtual_plane", virtual_plane)
         self.escape = self.default_escape if escape is None else check_bool("escape", escape)
+        if self.markov and self.escape:
+            raise ValueError("markov=True has no escape (it needs memory); pass escape=False")
 
     def new_memory(self) -> dict[str, Any]:
         return {"path": None, "index": 0, "plan": {}, "control_points": 0}
@@ -159,13 +163,33 @@ class PotentialFieldPolicy(_ArmPolicy):
         speed = float(np.linalg.norm(x_dot))
         return x_dot * (GRIPPER_SPEED / speed) if speed > GRIPPER_SPEED else x_dot
 
+    def field_velocity(self, o: dict[str, np.ndarray], x: np.ndarray) -> np.ndarray:
+        """``X_dot`` (dim,) of the Markov option: eq. 7's field at the gripper ``x``."""
+        to_fruit = o["fruit"] - x
+        if float(np.linalg.norm(to_fruit)) <= GRIPPER_SPEED * self.dt:
+            return to_fruit / self.dt
+        mask = o["mask"]
+        direction = field_direction(
+            x,
+            o["fruit"],
+            o["a"][mask],
+            o["b"][mask],
+            o["radius"][mask],
+            self.link_radius,
+            virtual_plane=self.virtual_plane,
+        )
+        return GRIPPER_SPEED * direction
+
     def act(self, observation: np.ndarray, memory: dict[str, Any]) -> np.ndarray:
         o = self.layout.parse(observation)
         points, jacs = self.kin.jacobians(o["q"])  # (P, dim), (P, dim, n)
-        if memory["path"] is None:
-            memory["path"] = self.plan(o, points[-1], memory["plan"])
-            memory["fruit"] = o["fruit"]
-        x_dot = self.gripper_velocity(points[-1], memory)
+        if self.markov:
+            x_dot = self.field_velocity(o, points[-1])
+        else:
+            if memory["path"] is None:
+                memory["path"] = self.plan(o, points[-1], memory["plan"])
+                memory["fruit"] = o["fruit"]
+            x_dot = self.gripper_velocity(points[-1], memory)
         jn = jacs[-1]  # (dim, n) the gripper's
         jacs, refs, weights = self.reference_velocities(o, points, jacs, x_dot, memory)
         rates = limited_rates(
