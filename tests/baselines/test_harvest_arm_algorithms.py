@@ -558,4 +558,6 @@ def test_the_markov_option_acts_from_the_observation_alone():
     assert differs[False] > 0.01, differs
     np.testing.assert_allclose(firsts[True], firsts[False], atol=0.02)
     with pytest.raises(ValueError, match="markov=True has no escape"):
-        PotentialFieldPolicy(env.observation_space, env.action_space, kwargs, markov=True, escape=True)
+        PotentialFieldPolicy(
+            env.observation_space, env.action_space, kwargs, markov=True, escape=True
+        )
