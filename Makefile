@@ -76,7 +76,7 @@ lint: $(STAMP)
 # evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
 SEEDS ?= 0 1 2
 # Agents from demonstrations (DAgger, configs/<ID>-dagger.yml), shipped as sac-dagger.
-DAGGER_IDS ?= ExcavatorReach-v1 DualArmCell-v1
+DAGGER_IDS ?= ExcavatorReach-v1 DualArmCell-v1 HarvestArm-v0 HarvestArmPlanar-v0
 IDS ?= Sweeper-v0 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
 # Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
 # as <algo>-residual.
