@@ -77,7 +77,7 @@ lint: $(STAMP)
 SEEDS ?= 0 1 2
 # Agents from demonstrations (DAgger, configs/<ID>-dagger.yml), shipped as sac-dagger.
 # (configs/Sweeper-v1-dagger.yml is a trial, not shipped: docs/experiments/Sweeper-v1.md.)
-DAGGER_IDS ?= ExcavatorReach-v0 ExcavatorReach-v1 DualArmCell-v1
+DAGGER_IDS ?= ExcavatorReach-v0 ExcavatorReach-v1 DualArmCell-v1 HarvestArm-v0 HarvestArmPlanar-v0
 IDS ?= Sweeper-v0 Sweeper-v1 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
 # Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
 # as <algo>-residual.
