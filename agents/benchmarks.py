@@ -125,15 +125,16 @@ def benchmark_section(env_id: str, n_episodes: int, figures: Path, root: Path) -
         learned.append(evaluation)
         seeds = metrics["held_out_seeds"]
     env = make_env(env_id)
+    names = list(scripted_policies(env_id))  # the paper's declared first, then sorted
     scripted = [
         evaluate(env, load_predictor(name, env_id, env), seeds, env_id, name, progress=False)
-        for name in sorted(scripted_policies(env_id))
+        for name in names[:1] + sorted(names[1:])
     ]
     env.close()
     if not scripted + learned:
         return f"### {env_id}\n\nNo scripted policy or shipped model yet.\n"
     lines = [f"### {env_id}", "", comparison_markdown(scripted + learned)]
-    paper = next(iter(scripted_policies(env_id)), None)  # declared first: the paper's
+    paper = names[0] if names else None
     reference = None
     for evaluation in scripted:
         if evaluation.policy == paper and "is_success" in evaluation.summary():
