@@ -54,7 +54,7 @@ imitate        a scripted policy's name: DAgger                      null
                states; normalisation statistics: the teacher's
                states, frozen. With ``n_timesteps: 0`` no RL follows
 imitate_kwargs the teacher's own keywords (mapping), e.g.              {}
-               ``track_progress: true`` for the dual-arm schedules
+               ``replan: true`` for the excavator reach teacher
 dagger_iterations learner-acting DAgger iterations after the          4
                teacher's (0: plain behaviour cloning)
 dagger_episodes episodes rolled out per DAgger iteration             50

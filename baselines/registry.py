@@ -35,7 +35,7 @@ def make_policy(
     **options: Any,
 ) -> ScriptedPolicy:
     """Instantiate the scripted policy ``name`` declared for ``env_id``; ``options`` go to
-    its constructor (its own keywords, e.g. ``track_progress`` of the dual-arm schedules)."""
+    its constructor (its own keywords, e.g. ``replan`` of the excavator reach teacher)."""
     declared = scripted_policies(env_id)
     if name not in declared:
         choices = ", ".join(sorted(declared)) or "none"

@@ -30,7 +30,7 @@ from motiongym.baselines.dual_arm.boundary_following import boundary_following
 from motiongym.baselines.dual_arm.bracket import exact_delay_search
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.core import check_bool, params_from_kwargs
+from motiongym.envs.core import params_from_kwargs
 from motiongym.envs.dual_arm.params import DualArmParams
 from motiongym.envs.dual_arm.task import DT
 from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
@@ -50,17 +50,6 @@ class SchedulePolicy(ScriptedPolicy):
             to sequential operation (v1: to the exact minimum pure delay). The
             memory records ``margin`` and ``replans`` (the guard's firings); a
             plan that says no pure delay exists (``reason``) is not re-planned.
-        track_progress: act in closed loop on robot 2's observed progress
-            instead of replaying the schedule by the clock (default False: the
-            replay above). Robot 2's advance is then what brings it to the
-            schedule's progress at robot 1's next sample, ``clip(S(p_1 + 1) -
-            p_2, 0, 1)`` with ``S`` the schedule's cumulative advances (linear
-            between samples; 1 once robot 1 is done): the same actions along
-            the schedule's own run (``p_1`` = the step, ``p_2 = S(step)``), and
-            from any other state the way back onto its path in the collision
-            map (wait while robot 2 is ahead, catch up while behind). The
-            labels a learner needs from a teacher on its own states (DAgger,
-            :mod:`motiongym.agents.dagger`).
     """
 
     def __init__(
@@ -73,10 +62,8 @@ class SchedulePolicy(ScriptedPolicy):
         verify: bool = True,
         replan_step: float = 0.005,
         max_replans: int = 10,
-        track_progress: bool = False,
     ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
-        self.track_progress = check_bool("track_progress", track_progress)
         if action_space.shape not in ((1,), (2,)):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
@@ -147,26 +134,9 @@ class SchedulePolicy(ScriptedPolicy):
         step = int(round(float(obs[OBS["elapsed"]][0]) / DT))
         adv = memory["schedule"].advances
         a2 = float(adv[step]) if step < len(adv) else 1.0
-        if self.track_progress:
-            a2 = self._tracked_advance(obs, memory)
         if self.action_space.shape == (2,):
             return np.array([1.0, a2], dtype=np.float32)
         return np.array([a2], dtype=np.float32)
-
-    def _tracked_advance(self, obs: np.ndarray, memory: dict[str, Any]) -> float:
-        """Robot 2's advance onto the schedule's progress at robot 1's next sample."""
-        traj1, traj2 = memory["tasks"]
-        p1, p2 = obs[OBS["progress"]].astype(float) * (traj1.n_samples, traj2.n_samples)
-        if p1 >= traj1.n_samples:
-            return 1.0
-        if "cumulative" not in memory:
-            advances = memory["schedule"].advances
-            memory["cumulative"] = np.concatenate([[0.0], np.cumsum(advances)])
-        cumulative = memory["cumulative"]
-        wanted = float(np.interp(p1 + 1.0, np.arange(len(cumulative)), cumulative))
-        advance = float(np.clip(wanted - p2, 0.0, 1.0))
-        # The observed progress is float32 (p_2 / N_2 rounded): snap its 1e-5 samples.
-        return float(round(advance)) if abs(advance - round(advance)) < 1e-3 else advance
 
 
 class BoundaryFollowingPolicy(SchedulePolicy):
