@@ -42,7 +42,7 @@ from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.vec_env import VecNormalize
 
-from motiongym.agents.dataset import DATASET_SEED
+from motiongym.agents.dataset import DATASET_SEED, stack_steps
 from motiongym.agents.imitation import behaviour_clone
 from motiongym.envs.core import check_int
 
@@ -115,13 +115,6 @@ def _learner(
         return np.clip(action, space.low, space.high)
 
     return act
-
-
-def _stacked(observations: list[Any]) -> Any:
-    """The observations as one array, or one array per key (Dict spaces)."""
-    if observations and isinstance(observations[0], dict):
-        return {k: np.stack([o[k] for o in observations]) for k in observations[0]}
-    return np.asarray(observations)
 
 
 def _label_error(guesses: list[np.ndarray], labels: list[np.ndarray], discrete: bool) -> float:
@@ -202,7 +195,7 @@ def dagger(
             guesses += guess
             successes.append(success)
         if iteration == 0 and normalization is not None:
-            stacked = _stacked(new_obs)
+            stacked = stack_steps(new_obs)
             if isinstance(stacked, dict):
                 for key, rms in normalization.obs_rms.items():
                     rms.update(stacked[key])
@@ -214,7 +207,7 @@ def dagger(
         labels += new_labels
         losses = behaviour_clone(
             model,
-            normalize(_stacked(observations)),
+            normalize(stack_steps(observations)),
             np.asarray(labels),
             epochs=epochs,
             seed=training_seed + iteration,

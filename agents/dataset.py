@@ -121,7 +121,7 @@ def record_dataset(
     return path, successes / episodes
 
 
-def _stacked(items: list[Any]) -> Any:
+def stack_steps(items: list[Any]) -> Any:
     """A list of arrays (or of dicts of them) as one array (or a dict of arrays), step first."""
     if isinstance(items[0], dict):
         return {k: np.stack([np.asarray(i[k]) for i in items]) for k in items[0]}
@@ -154,12 +154,12 @@ def _episode(minari: Any, env: gym.Env, teacher: Any, seed: int, index: int) -> 
     return minari.data_collector.EpisodeBuffer(
         id=index,
         seed=seed,
-        observations=_stacked(observations),
-        actions=_stacked(actions),
+        observations=stack_steps(observations),
+        actions=stack_steps(actions),
         rewards=list(map(float, rewards)),
         terminations=list(map(bool, terminations)),
         truncations=list(map(bool, truncations)),
-        infos=_stacked(infos),
+        infos=stack_steps(infos),
     )
 
 

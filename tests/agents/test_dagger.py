@@ -252,7 +252,8 @@ def test_behaviour_cloning_fits_discrete_labels_by_cross_entropy():
     most likely action then agrees with most labels."""
     from sb3_contrib import MaskablePPO
 
-    from motiongym.agents.dagger import _rollout, _stacked
+    from motiongym.agents.dagger import _rollout
+    from motiongym.agents.dataset import stack_steps
     from motiongym.agents.imitation import behaviour_clone
 
     env = gym.make(SWEEPER, max_episode_steps=200)
@@ -265,7 +266,7 @@ def test_behaviour_cloning_fits_discrete_labels_by_cross_entropy():
 
     kwargs = {**block, "features_extractor_class": FEATURES_EXTRACTORS["sweeper_egocentric"]}
     model = MaskablePPO("MultiInputPolicy", env, policy_kwargs=kwargs, seed=0, device="cpu")
-    data, actions = _stacked(observations), np.asarray(labels)
+    data, actions = stack_steps(observations), np.asarray(labels)
     losses = behaviour_clone(model, data, actions, epochs=30, batch_size=64, seed=0)
     assert abs(losses[0] - np.log(3)) < 0.15 and losses[-1] < 0.5 * losses[0], losses
     guesses, _ = model.predict(data, deterministic=True)
