@@ -35,38 +35,7 @@ import numpy as np
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper.belief import OBSTACLE, RobotMap
 from motiongym.baselines.sweeper.psa_cwa import FORWARD, LEFT, robot_geometry, turn_towards
-from motiongym.envs.sweeper.occupancy import DC, DR
-
-FAR = np.iinfo(np.int32).max
-
-
-def footprint_any(cells: np.ndarray, w: int) -> np.ndarray:
-    """``(H - w + 1, W - w + 1)``: whether the ``w x w`` block at each top-left cell holds a
-    true cell of ``cells`` (``(H, W)`` bool)."""
-    h, v = cells.shape[0] - w + 1, cells.shape[1] - w + 1
-    out = np.zeros((max(h, 0), max(v, 0)), bool)
-    for i in range(w):
-        for j in range(w):
-            out |= cells[i : i + h, j : j + v]
-    return out
-
-
-def goal_distance(open_: np.ndarray, goal: np.ndarray) -> np.ndarray:
-    """Moves from every open configuration to the nearest goal (:data:`FAR`: none
-    reachable), by breadth-first search over 4-neighbours from all goals at once."""
-    dist = np.full(open_.shape, FAR, np.int32)
-    frontier = goal & open_
-    d = 0
-    while frontier.any():
-        dist[frontier] = d
-        grown = np.zeros_like(frontier)
-        grown[1:] |= frontier[:-1]
-        grown[:-1] |= frontier[1:]
-        grown[:, 1:] |= frontier[:, :-1]
-        grown[:, :-1] |= frontier[:, 1:]
-        frontier = grown & open_ & (dist == FAR)
-        d += 1
-    return dist
+from motiongym.envs.sweeper.occupancy import DC, DR, bfs_distance, box_sum, config_free
 
 
 class NearestUnsweptPolicy(ScriptedPolicy):
@@ -84,14 +53,14 @@ class NearestUnsweptPolicy(ScriptedPolicy):
         r0, c0, occ, swept = memory.window()
         w = self.w
         obstacle = occ == OBSTACLE
-        open_ = ~footprint_any(obstacle, w)
-        goal = open_ & footprint_any(~swept & ~obstacle, w)
-        dist = goal_distance(open_, goal)
-        best, action = FAR, LEFT
+        open_ = config_free(obstacle, w)
+        goal = open_ & (box_sum((~swept & ~obstacle).astype(np.int64), w) > 0)
+        dist = bfs_distance(open_, goal)  # -1: no goal reachable
+        best, action = np.iinfo(np.int64).max, LEFT
         for k in (0, 1, 3, 2):  # ahead, left, right, back: ties favour the first
             heading = (h + k) % 4
             i, j = r - r0 + DR[heading], c - c0 + DC[heading]
-            if 0 <= i < dist.shape[0] and 0 <= j < dist.shape[1] and dist[i, j] < best:
+            if 0 <= i < dist.shape[0] and 0 <= j < dist.shape[1] and 0 <= dist[i, j] < best:
                 best = dist[i, j]
                 action = FORWARD if k == 0 else turn_towards(h, heading)
         return int(action)

@@ -185,17 +185,20 @@ def smartdfs_bound(
     return SmartDfsBound(c_count, edges, obstacle_count(reachable), int(reachable.sum()), w)
 
 
-def bfs_distance(free: np.ndarray, start: tuple[int, int]) -> np.ndarray:
+def bfs_distance(free: np.ndarray, start: tuple[int, int] | np.ndarray) -> np.ndarray:
     """``(H, W)`` int: 4-connected step distance from ``start`` over ``free`` (-1: unreached).
 
-    A wavefront expansion, one NumPy dilation per distance level.
+    ``start``: one cell, or an ``(H, W)`` bool mask of sources (the distance to the
+    nearest of them; sources off ``free`` are ignored). A wavefront expansion, one NumPy
+    dilation per distance level.
     """
     dist = np.full(free.shape, -1, dtype=np.int64)
-    if not free[start]:
-        return dist
-    dist[start] = 0
     frontier = np.zeros_like(free)
     frontier[start] = True
+    frontier &= free
+    if not frontier.any():
+        return dist
+    dist[frontier] = 0
     seen = frontier.copy()
     level = 0
     while frontier.any():

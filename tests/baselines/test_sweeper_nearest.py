@@ -9,30 +9,36 @@ import pytest
 import motiongym  # noqa: F401
 from motiongym.agents.sweeper_runs import run_sweep
 from motiongym.baselines.registry import make_policy
-from motiongym.baselines.sweeper.nearest import FAR, footprint_any, goal_distance
+from motiongym.envs.sweeper.occupancy import bfs_distance, box_sum
 
 ENV_ID = "motiongym/Sweeper-v1"
 
 
-def test_goal_distance_counts_moves_around_a_wall() -> None:
-    """A 5 x 5 grid, a wall across rows 0-3 of column 2: from (0, 0) to the goal (0, 4) is
-    4 moves down and back up around the wall plus 4 across, 12; a closed cell is FAR."""
+def test_distance_to_the_nearest_goal_counts_moves_around_a_wall() -> None:
+    """The teacher's distances (``bfs_distance`` from a mask of goals): a 5 x 5 grid, a
+    wall across rows 0-3 of column 2: from (0, 0) to the goal (0, 4) is 4 moves down and
+    back up around the wall plus 4 across, 12; a closed cell is unreached (-1)."""
     open_ = np.ones((5, 5), bool)
     open_[0:4, 2] = False
     goal = np.zeros((5, 5), bool)
     goal[0, 4] = True
-    dist = goal_distance(open_, goal)
+    dist = bfs_distance(open_, goal)
     assert dist[0, 4] == 0 and dist[0, 0] == 12 and dist[4, 2] == 6
-    assert dist[0, 2] == FAR
+    assert dist[0, 2] == -1
     shut = open_.copy()
     shut[4, 2] = False  # the wall now splits the grid
-    assert goal_distance(shut, goal)[0, 0] == FAR
+    assert bfs_distance(shut, goal)[0, 0] == -1
+    two = goal.copy()
+    two[4, 0] = True  # a second goal: the distance is to the nearer one
+    assert bfs_distance(open_, two)[0, 0] == 4
 
 
-def test_footprint_any_marks_every_top_left_cell_whose_block_holds_one() -> None:
+def test_goal_blocks_are_every_top_left_cell_whose_block_holds_one() -> None:
+    """The teacher's goal test (``box_sum > 0``) over the configurations whose 3 x 3
+    footprint lies inside the 5 x 6 grid."""
     cells = np.zeros((5, 6), bool)
     cells[2, 3] = True
-    blocks = footprint_any(cells, 3)
+    blocks = (box_sum(cells.astype(np.int64), 3) > 0)[:3, :4]
     assert blocks.shape == (3, 4)
     assert sorted(zip(*np.nonzero(blocks), strict=True)) == [
         (r, c) for r in range(3) for c in range(1, 4)
