@@ -44,8 +44,6 @@ residual_scale the correction's range, in (0, 2], as a multiple of   1.0
                the action bounds
 residual_kwargs that scripted policy's own keywords (mapping), e.g.     {}
                ``tolerance`` of the dig cycle
-residual_penalty weight of the correction's cost, ``-w mean(f^2)`` a    0.0
-               step, added to the training reward (ResidualWrapper)
 demonstrations a Minari dataset folder (``motiongym dataset``): the   null
                policy is behaviour-cloned on it
                (:mod:`motiongym.agents.imitation`) before RL;
@@ -101,7 +99,6 @@ RUN_SETTINGS: dict[str, Any] = {
     "residual": None,
     "residual_scale": 1.0,
     "residual_kwargs": {},
-    "residual_penalty": 0.0,
     "demonstrations": None,
     "bc_epochs": 20,
     "imitate": None,
@@ -282,10 +279,8 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
     check_float("residual_scale", config["residual_scale"], 0.0, 2.0, low_open=True)
     if not isinstance(config["residual_kwargs"], dict):
         raise ArgumentError(f"residual_kwargs must be a mapping, got {config['residual_kwargs']!r}")
-    check_float("residual_penalty", config["residual_penalty"], 0.0, 1e6)
-    for key in ("residual_kwargs", "residual_penalty"):
-        if config[key] and config["residual"] is None:
-            raise ArgumentError(f"{key} needs residual")
+    if config["residual_kwargs"] and config["residual"] is None:
+        raise ArgumentError("residual_kwargs needs residual")
     if config["demonstrations"] is not None and not isinstance(config["demonstrations"], str):
         raise ArgumentError(
             f"demonstrations must be a dataset folder, got {config['demonstrations']!r}"

@@ -49,15 +49,6 @@ class ResidualWrapper(gym.Wrapper):
         policy_kwargs: the scripted policy's own keywords when ``policy`` is a
             name (e.g. the dig cycle's ``tolerance``: a plan that passes a
             goal only within a tolerance below one step's correction stalls).
-        penalty: weight of the reward term ``correction = -penalty * mean(f^2)``
-            (``f`` the learner's action in [-1, 1]; 0: the environment's
-            reward alone). Where the correction changes nothing the
-            environment rewards (the scripted policy re-corrects it next
-            step), the critic's value is flat in ``f`` and the actor's most
-            likely correction drifts with the critic's noise; the term gives
-            every state a definite pull toward the scripted action, which a
-            correction then keeps only where it pays more. Added to ``info``
-            as ``reward_correction`` (the reward terms still sum to the reward).
     """
 
     def __init__(
@@ -66,7 +57,6 @@ class ResidualWrapper(gym.Wrapper):
         policy: str | ScriptedPolicy,
         scale: float = 1.0,
         policy_kwargs: dict[str, Any] | None = None,
-        penalty: float = 0.0,
     ) -> None:
         super().__init__(env)
         env_id = env.spec.id if env.spec else None
@@ -91,7 +81,6 @@ class ResidualWrapper(gym.Wrapper):
             )
         self.policy = policy
         self.scale = check_float("scale", scale, 0.0, 2.0, low_open=True)
-        self.penalty = check_float("penalty", penalty, 0.0, 1e6)
         box = env.action_space
         self.action_space = spaces.Box(-1.0, 1.0, box.shape, np.float32)
         self._obs: Any = None
@@ -109,11 +98,7 @@ class ResidualWrapper(gym.Wrapper):
         applied = _combined(base, correction, self.scale, box)
         obs, reward, terminated, truncated, info = self.env.step(applied.astype(box.dtype))
         self._obs = obs
-        info = {**info, "base_action": base}
-        if self.penalty:
-            term = -self.penalty * float(np.mean(np.square(correction)))
-            reward, info["reward_correction"] = float(reward) + term, term
-        return obs, reward, terminated, truncated, info
+        return obs, reward, terminated, truncated, {**info, "base_action": base}
 
 
 def _combined(

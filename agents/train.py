@@ -147,7 +147,6 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
             "policy": residual,
             "scale": config["residual_scale"],
             "policy_kwargs": config["residual_kwargs"],
-            "penalty": config["residual_penalty"],
         }
         if residual
         else None,

@@ -83,22 +83,6 @@ def test_residual_correction_is_scaled_and_clipped_to_the_action_box():
     np.testing.assert_allclose(sent[0], expected, atol=1e-6)
 
 
-def test_residual_penalty_is_a_reward_term_of_the_correction():
-    """``penalty``: the reward less ``penalty * mean(f^2)``, reported as ``reward_correction``
-    (the terms still sum to the reward); without it the environment's reward is untouched."""
-    rewards = {}
-    for penalty in (0.0, 0.5):
-        env = ResidualWrapper(gym.make(REACH), "newton-raphson-reach", 0.3, penalty=penalty)
-        env.reset(seed=0)
-        _, reward, _, _, info = env.step(np.array([1.0, -0.5, 0.0, 0.0], np.float32))
-        terms = sum(v for k, v in info.items() if k.startswith("reward_"))
-        assert reward == pytest.approx(terms)
-        rewards[penalty] = (reward, info.get("reward_correction"))
-    assert rewards[0.0][1] is None
-    assert rewards[0.5][1] == pytest.approx(-0.5 * (1.0 + 0.25) / 4)
-    assert rewards[0.5][0] == pytest.approx(rewards[0.0][0] + rewards[0.5][1])
-
-
 def test_residual_refuses_a_policy_of_another_id_and_bad_arguments():
     other = gym.make("motiongym/ExcavatorReach-v0")
     policy = make_policy(
@@ -115,8 +99,6 @@ def test_residual_refuses_a_policy_of_another_id_and_bad_arguments():
         ResidualWrapper(gym.make(REACH), "newton-raphson-reach", scale=0.0)
     with pytest.raises(ValueError, match="Box action space"):
         ResidualWrapper(gym.make("motiongym/Sweeper-v0"), "boustrophedon")
-    with pytest.raises(ValueError, match="penalty"):
-        ResidualWrapper(gym.make(REACH), "newton-raphson-reach", penalty=-1.0)
     reach = gym.make(REACH)
     reach_policy = make_policy(
         REACH,
@@ -173,9 +155,7 @@ def test_a_correction_stalls_the_dig_cycle_only_below_its_goal_tolerance():
     ("lines", "message"),
     [
         ("  residual_kwargs:\n    replan: true\n", "residual_kwargs needs residual"),
-        ("  residual_penalty: 0.1\n", "residual_penalty needs residual"),
         ("  residual: newton-raphson-reach\n  residual_kwargs: 3\n", "residual_kwargs must be a"),
-        ("  residual: newton-raphson-reach\n  residual_penalty: -1\n", "residual_penalty must be"),
         (
             "  residual: newton-raphson-reach\n  residual_kwargs:\n    tolerance: 0.01\n",
             "residual_kwargs for 'newton-raphson-reach': .*tolerance",
@@ -283,6 +263,7 @@ def test_a_run_with_demonstrations_clones_before_rl(demonstrations, tmp_path):
         "HarvestArmPlanar-v1-residual",
         "ExcavatorReach-v1-residual",
         "Excavator-v1-residual",
+        "Excavator-v0-residual",
     ],
 )
 def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
@@ -299,7 +280,9 @@ def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
     path = resources.files("motiongym.configs") / f"{name}.yml"
     block = yaml.safe_load(path.read_text())["sac"]
     block.update(n_timesteps=48, learning_starts=16, batch_size=16, eval_freq=48)
-    block.update(n_eval_episodes=1, env_kwargs={**block["env_kwargs"], "max_episode_steps": 24})
+    block.update(
+        n_eval_episodes=1, env_kwargs={**block.get("env_kwargs", {}), "max_episode_steps": 24}
+    )
     config = tmp_path / "tiny.yml"
     config.write_text(yaml.safe_dump({"sac": block}))
     assert (train(env_id, "sac", config, out_root=tmp_path, progress=False) / "model.zip").is_file()
