@@ -81,7 +81,7 @@ DAGGER_IDS ?= ExcavatorReach-v0 ExcavatorReach-v1 DualArmCell-v1 HarvestArm-v0 H
 IDS ?= Sweeper-v0 Sweeper-v1 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
 # Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
 # as <algo>-residual.
-RESIDUAL_IDS ?= Excavator-v1 ExcavatorReach-v1
+RESIDUAL_IDS ?= Excavator-v1 Excavator-v0 ExcavatorReach-v1
 models: $(STAMP)
 	for id in $(IDS); do \
 	  for seed in $(SEEDS); do \

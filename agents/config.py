@@ -42,6 +42,8 @@ residual       a scripted policy's name: train a residual agent          null
                ``vec_env`` dummy or subproc
 residual_scale the correction's range, in (0, 2], as a multiple of   1.0
                the action bounds
+residual_kwargs that scripted policy's own keywords (mapping), e.g.     {}
+               ``tolerance`` of the dig cycle
 demonstrations a Minari dataset folder (``motiongym dataset``): the   null
                policy is behaviour-cloned on it
                (:mod:`motiongym.agents.imitation`) before RL;
@@ -96,6 +98,7 @@ RUN_SETTINGS: dict[str, Any] = {
     "deterministic": True,
     "residual": None,
     "residual_scale": 1.0,
+    "residual_kwargs": {},
     "demonstrations": None,
     "bc_epochs": 20,
     "imitate": None,
@@ -274,6 +277,10 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
             f"residual must be a scripted policy's name, got {config['residual']!r}"
         )
     check_float("residual_scale", config["residual_scale"], 0.0, 2.0, low_open=True)
+    if not isinstance(config["residual_kwargs"], dict):
+        raise ArgumentError(f"residual_kwargs must be a mapping, got {config['residual_kwargs']!r}")
+    if config["residual_kwargs"] and config["residual"] is None:
+        raise ArgumentError("residual_kwargs needs residual")
     if config["demonstrations"] is not None and not isinstance(config["demonstrations"], str):
         raise ArgumentError(
             f"demonstrations must be a dataset folder, got {config['demonstrations']!r}"

@@ -285,7 +285,12 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
 
         kwargs = env.spec.kwargs if env.spec else resolved_env_kwargs(env_id, None)
         scripted = make_policy(
-            env_id, config["residual"], env.observation_space, env.action_space, kwargs
+            env_id,
+            config["residual"],
+            env.observation_space,
+            env.action_space,
+            kwargs,
+            **config.get("residual_kwargs", {}),
         )
         predictor = ResidualPredictor(
             predictor, scripted, config.get("residual_scale", 1.0), env.action_space

@@ -46,17 +46,33 @@ class ResidualWrapper(gym.Wrapper):
             :class:`ScriptedPolicy` made for that ID (``make_policy``).
         scale: the correction's range as a multiple of the action bounds, in
             (0, 2] (1: a correction can move the action anywhere in the box).
+        policy_kwargs: the scripted policy's own keywords when ``policy`` is a
+            name (e.g. the dig cycle's ``tolerance``: a plan that passes a
+            goal only within a tolerance below one step's correction stalls).
     """
 
-    def __init__(self, env: gym.Env, policy: str | ScriptedPolicy, scale: float = 1.0) -> None:
+    def __init__(
+        self,
+        env: gym.Env,
+        policy: str | ScriptedPolicy,
+        scale: float = 1.0,
+        policy_kwargs: dict[str, Any] | None = None,
+    ) -> None:
         super().__init__(env)
         env_id = env.spec.id if env.spec else None
         if not isinstance(env.action_space, spaces.Box):
             raise ValueError(f"env must have a Box action space, got {env.action_space}")
         if isinstance(policy, str):
             policy = make_policy(
-                env_id, policy, env.observation_space, env.action_space, env.spec.kwargs
+                env_id,
+                policy,
+                env.observation_space,
+                env.action_space,
+                env.spec.kwargs,
+                **(policy_kwargs or {}),
             )
+        elif policy_kwargs:
+            raise ValueError("policy_kwargs go with a policy's name, not a made policy")
         elif not isinstance(policy, ScriptedPolicy) or policy.env_id != env_id:
             given = getattr(policy, "env_id", None)
             raise ValueError(

@@ -143,7 +143,11 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         monitor_dir=str(monitor_dir) if monitor_dir else None,
         vec_env_cls=vec_env_cls,
         wrapper_class=ResidualWrapper if residual else None,
-        wrapper_kwargs={"policy": residual, "scale": config["residual_scale"]}
+        wrapper_kwargs={
+            "policy": residual,
+            "scale": config["residual_scale"],
+            "policy_kwargs": config["residual_kwargs"],
+        }
         if residual
         else None,
     )
@@ -226,6 +230,23 @@ def _check_residual(env_id: str, config: dict[str, Any], where: Path) -> None:
         )
     if config["vec_env"] not in ("dummy", "subproc"):
         raise UsageError(f"{where}: a residual agent needs vec_env dummy or subproc")
+    if config["residual_kwargs"]:  # the policy's own check of its keywords, named here
+        from motiongym.baselines import make_policy
+
+        env = gym.make(env_id, **config["env_kwargs"])
+        try:
+            make_policy(
+                env_id,
+                name,
+                env.observation_space,
+                env.action_space,
+                env.spec.kwargs,
+                **config["residual_kwargs"],
+            )
+        except (TypeError, ValueError) as error:
+            raise UsageError(f"{where}: residual_kwargs for {name!r}: {error}") from None
+        finally:
+            env.close()
     if config.get("replay_buffer_class") == "her":  # the stored correction fits one goal only
         raise UsageError(
             f"{where}: a residual agent cannot use replay_buffer_class her: the scripted "

@@ -22,7 +22,7 @@ from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.goal import for_goal_env
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.core import check_bool
+from motiongym.envs.core import check_bool, check_float
 from motiongym.envs.excavator.kinematics import base_pose, base_rotation
 from motiongym.envs.excavator.observation import PROFILE_RADII, layout
 from motiongym.envs.excavator.params import params_for
@@ -157,16 +157,42 @@ class DigCyclePolicy(_ExcavatorPolicy):
     the observation), the curl and lift rise along the world's vertical, and a
     curl that the ground stops (no motion for ``STALL_STEPS`` steps) is
     answered by raising the boom alone (stage ``raise``) and curling anew.
+
+    Args:
+        tolerance: a joint goal counts as reached when every joint is within
+            this many radians of it (default ``REACHED``, 2 mrad). The plan is
+            followed goal by goal, each passed only once reached, so an action
+            changed after the policy chose it (a residual agent's correction,
+            :mod:`motiongym.agents.residual`) must not move the joints by more
+            than the tolerance in a step: the dead-beat tracking
+            (:func:`.tracking.track`) leaves the joints ``c * rate_max * dt``
+            past the goal after a step with correction ``c``, so with the
+            default a steady correction above ~35 % of a 0.05-scale residual's
+            range (swing: 0.05 x 1.15 rad/s x 0.1 s = 5.75 mrad) never lets
+            the plan advance (docs/experiments/Excavator-v1.md). Residual
+            agents take ``REACHED + scale * max(rate_max) * dt`` or more
+            (the shipped ones: 0.01 at scale 0.05).
     """
 
     TASK = "dig"
 
-    def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
+    def __init__(
+        self, observation_space, action_space, env_kwargs=None, tolerance: float = REACHED
+    ) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
         self.style = bp.V1_STYLE if self.params.physics == "v1" else bp.V0_STYLE
+        self.tolerance = check_float("tolerance", tolerance, 0.0, 0.5, low_open=True)
 
     def new_memory(self) -> dict:
-        return {"stage": None, "goals": None, "index": 0, "depth": None, "still": 0, "replans": 0}
+        return {
+            "stage": None,
+            "goals": None,
+            "index": 0,
+            "depth": None,
+            "still": 0,
+            "replans": 0,
+            "tolerance": self.tolerance,
+        }
 
     def _stalled(self, obs: np.ndarray, memory: dict) -> bool:
         """Whether the machine has not moved for ``STALL_STEPS`` steps short of its goal
@@ -197,7 +223,7 @@ class DigCyclePolicy(_ExcavatorPolicy):
 
     def _done(self, q: np.ndarray, memory: dict) -> bool:
         return memory["index"] == len(memory["goals"]) - 1 and (
-            np.max(np.abs(memory["goals"][-1] - q)) < REACHED
+            np.max(np.abs(memory["goals"][-1] - q)) < memory["tolerance"]
         )
 
     def _scene(self, obs: np.ndarray) -> dict:

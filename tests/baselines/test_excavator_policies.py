@@ -298,3 +298,22 @@ def test_replan_must_be_a_bool():
             env.spec.kwargs,
             replan="yes",
         )
+
+
+def test_dig_cycle_tolerance_is_checked_and_defaults_to_reached():
+    from motiongym.baselines.excavator.policies import REACHED
+
+    env = gym.make("motiongym/Excavator-v1")
+    make = lambda **kw: make_policy(  # noqa: E731
+        "motiongym/Excavator-v1",
+        "dig-cycle",
+        env.observation_space,
+        env.action_space,
+        env.spec.kwargs,
+        **kw,
+    )
+    assert make().tolerance == REACHED == 2e-3
+    assert make(tolerance=0.01).new_memory()["tolerance"] == 0.01
+    for bad in (0.0, -0.01, 0.6, float("nan"), "0.01"):
+        with pytest.raises(ValueError, match="tolerance must be a finite number in"):
+            make(tolerance=bad)
