@@ -16,7 +16,9 @@ writes into ``out_dir`` (``sweeper.json`` and PNG figures):
    is on the strict side.
 2. Start-position sensitivity on the maze (4.1.2, Fig. 15): travel from every
    feasible start configuration (a regular sample with ``quick``), its spread
-   ``(max - min) / min`` beside the paper's ~3 %, and a grey-level image.
+   ``(max - min) / min`` beside the paper's ~3 %, and a grey-level image; and
+   the same spread on the maze enlarged 2-4 times (:mod:`.sweeper_scale`: the
+   relative spread falls as the maze grows in robot widths).
 3. Start-orientation sensitivity (4.1.3, Fig. 16-17): the four start
    headings (the orientations a robot on our grid can take, all at 0 or 90
    degrees to the walls) from a fixed start on the maze, travel spread beside
@@ -41,7 +43,7 @@ import gymnasium as gym
 import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
-from motiongym.agents.reproduce import sweeper_odometry, sweeper_report
+from motiongym.agents.reproduce import sweeper_odometry, sweeper_report, sweeper_scale
 from motiongym.agents.sweeper_runs import run_sweep, sweeper_policy
 from motiongym.baselines.sweeper.psa_cwa import (
     PsaCwaBfsTransferPolicy,
@@ -382,6 +384,7 @@ def run(out_dir: pathlib.Path, quick: bool = False, seeds: int | None = None) ->
     results["coverage"] = coverage_study(quick)
     results["corner_work"] = corner_work_study(quick)
     results["start_position"] = start_position_study(quick)
+    results["start_scale"] = sweeper_scale.scale_study(quick)
     results["orientation"] = orientation_study(quick)
     results["odometry"] = sweeper_odometry.odometry_table(quick, seeds)
     results["odometry"]["summary"] = sweeper_odometry.summary(results["odometry"]["rows"])

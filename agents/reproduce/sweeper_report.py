@@ -173,6 +173,14 @@ def print_results(results: dict) -> None:
         f"{sp['travel_std']:.1f} / {sp['sweeping_std']:.1f} / {sp['between_runs_std']:.1f} cells",
         "",
     )
+    for row in results["start_scale"]:
+        t.add_row(
+            f"  maze x{row['k']} ({row['reading']}, {row['starts']} random starts): spread; "
+            "5-95 % / median; travel",
+            f"{100 * row['spread']:.1f} %; {100 * row['spread_p5_p95']:.1f} %; "
+            f"{row['travel_mean']:.0f} cells = {row['travel_mean_widths']:.0f} robot widths",
+            "3.2 % at about 20,500 base units (robot width not given)" if row["k"] == 1 else "",
+        )
     t.add_row(
         f"start orientation spread (maze, 4 headings at {tuple(ori['start'])})",
         f"{100 * ori['spread']:.1f} % (over {ori['starts']} starts: mean "

@@ -27,6 +27,15 @@ def test_reproduce_sweeper_quick(tmp_path, capsys) -> None:
     assert sp["starts"] > 30 and 0.0 <= sp["spread_of_max"] < sp["spread"] < 1.0
     assert sp["travel_max"] - sp["travel_min"] == pytest.approx(sp["spread"] * sp["travel_min"])
     assert 0.0 < sp["alignment_variance_share"] < 1.0 and "3.2 / 3.1 %" in printed
+    scale = results["start_scale"]  # the maze enlarged: travel between runs grows as its side
+    assert [(r["reading"], r["k"]) for r in scale] == [
+        (reading, k) for reading in ("ours", "paper's stack") for k in (1, 2)
+    ]
+    for small, large in (scale[0:2], scale[2:4]):
+        assert large["travel_mean"] > 3.0 * small["travel_mean"]  # the area: about k^2
+        share = [r["between_runs_mean"] / r["travel_mean"] for r in (small, large)]
+        assert share[1] < share[0]
+    assert "maze x2" in printed
     for name in ("room", "apartment", "maze", "procedural"):  # PSA leaves CWA nothing there
         row = results["coverage"][name]
         assert row["travel_shares"]["cwa"] < 0.01 and row["transfer_bfs_mean"] > 0.0
@@ -63,3 +72,13 @@ def test_seeds_only_for_an_experiment_that_takes_them(tmp_path) -> None:
     others = [name for name in experiments() if name != "sweeper"]
     with pytest.raises(UsageError, match="takes no --seeds"):
         reproduce(others[0], tmp_path, quick=True, seeds=3)
+
+
+def test_enlarged_maze_keeps_the_layout() -> None:
+    from motiongym.agents.reproduce.sweeper_scale import enlarged_maze
+    from motiongym.envs.sweeper import maps
+
+    maze = maps.shipped_map("maze")
+    big = enlarged_maze(3)
+    assert big.shape == (3 * maze.shape[0], 3 * maze.shape[1]) and big.dtype == bool
+    assert (big[::3, ::3] == maze).all() and (big[2::3, 1::3] == maze).all()
