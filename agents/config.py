@@ -66,7 +66,7 @@ memory         a learner-side memory added to the observation:         null
                builds it from the observations it is given.
                ``vec_env`` dummy or subproc; not with ``residual``
 memory_kwargs  the memory's settings (mapping): ``levels``, ``crop``,  {}
-               ``factor``, ``pooling`` (``max`` or ``mean``)
+               ``factor``
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its

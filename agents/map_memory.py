@@ -28,12 +28,14 @@ policies do), in the cells of a crop:
 Pyramid: level ``k`` (0 .. ``levels - 1``) is an ``n x n`` grid
 (``n = crop``) of blocks of ``b^k x b^k`` cells (``b = factor``), centred on
 the footprint's centre cell, so level ``k`` sees ``n b^k`` cells across.
-Level 0 is the cells themselves. At coarser levels a block's ``todo`` is the
-*maximum* over its cells (``pooling: max``: a block with one cell left to
-sweep reads 1, so a single leftover cell stays visible across the map; the
-ablation ``pooling: mean`` gives its fraction, 1 / b^2k for one cell, as the
-environment's coarse maps do), ``obstacle`` and ``unknown`` their fractions.
-Cells outside the arrays count as unknown. Every level is turned
+Level 0 is the cells themselves; at coarser levels each channel holds its
+fraction over the block's cells (a single leftover cell reads ``1 / b^2k``:
+unlike the environment's world-aligned coarse maps, whose blocks are fixed,
+these move with the robot and grow with the distance, so the cell is seen
+sharper as the robot nears it). Max pooling of ``todo`` (a block with one
+cell left reads 1) was tried and measured no better on the room
+(docs/experiments/Sweeper-v1.md), so it is not offered. Cells outside the
+arrays count as unknown. Every level is turned
 ``(1 - heading) mod 4`` quarter turns counter-clockwise, so that the heading
 points up (as :class:`~motiongym.agents.features.SweeperEgocentric` turns the
 windows). With an even ``w`` the footprint has no centre cell; the crop is
@@ -58,18 +60,17 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, UNKNOWN, RobotMap
-from motiongym.envs.core import ArgumentError, check_choice, check_int
+from motiongym.envs.core import ArgumentError, check_int
 from motiongym.envs.sweeper.occupancy import config_free, footprint_union
 
 MEMORY_KEY = "memory"
 CHANNELS = ("todo", "obstacle", "unknown")  # per level, in this order
-POOLINGS = ("max", "mean")
 
 
 def check_memory_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
-    """The pyramid's settings (``levels``, ``crop``, ``factor``, ``pooling``) checked,
-    defaults filled in; an unknown key or a bad value is an ``ArgumentError``."""
-    settings = {"levels": 3, "crop": 11, "factor": 3, "pooling": "max"}
+    """The pyramid's settings (``levels``, ``crop``, ``factor``) checked, defaults
+    filled in; an unknown key or a bad value is an ``ArgumentError``."""
+    settings = {"levels": 3, "crop": 11, "factor": 3}
     if not isinstance(kwargs, dict):
         raise ArgumentError(f"memory_kwargs must be a mapping, got {kwargs!r}")
     unknown = sorted(set(kwargs) - set(settings), key=str)
@@ -81,7 +82,6 @@ def check_memory_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
     check_int("memory_kwargs.levels", settings["levels"], 1, 4)
     check_int("memory_kwargs.crop", settings["crop"], 3, 31)
     check_int("memory_kwargs.factor", settings["factor"], 1, 9)
-    check_choice("memory_kwargs.pooling", settings["pooling"], POOLINGS)
     for key in ("crop", "factor"):
         if settings[key] % 2 == 0:  # blocks centred on the robot's cell
             raise ArgumentError(f"memory_kwargs.{key} must be odd, got {settings[key]}")
@@ -104,14 +104,14 @@ class SweeperMapMemory:
     Args:
         robot_width: ``w`` (cells).
         sensor_range: ``R`` (cells beyond the footprint; the windows are ``w + 2R``).
-        levels, crop, factor, pooling: the pyramid (:func:`check_memory_kwargs`).
+        levels, crop, factor: the pyramid (:func:`check_memory_kwargs`).
     """
 
     def __init__(self, robot_width: int, sensor_range: int, **kwargs: Any) -> None:
         settings = check_memory_kwargs(kwargs)
         self.w, self.R = int(robot_width), int(sensor_range)
         self.levels, self.crop = settings["levels"], settings["crop"]
-        self.factor, self.pooling = settings["factor"], settings["pooling"]
+        self.factor = settings["factor"]
         self.side = self.crop * self.factor ** (self.levels - 1)  # cells across the top level
         self.shape = (len(CHANNELS) * self.levels, self.crop, self.crop)
         self.map = RobotMap(self.w, self.R)
@@ -167,11 +167,7 @@ class SweeperMapMemory:
             block = self.factor**level
             start = (self.side - n * block) // 2
             region = cells[:, start : start + n * block, start : start + n * block]
-            blocks = region.reshape(len(CHANNELS), n, block, n, block)
-            pooled = blocks.mean((2, 4))
-            if self.pooling == "max":
-                pooled[0] = blocks[0].max((1, 3))
-            out.append(pooled)
+            out.append(region.reshape(len(CHANNELS), n, block, n, block).mean((2, 4)))
         pyramid = np.concatenate(out)
         return np.ascontiguousarray(np.rot90(pyramid, (1 - h) % 4, axes=(1, 2)))
 
