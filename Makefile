@@ -76,8 +76,10 @@ lint: $(STAMP)
 # evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
 SEEDS ?= 0 1 2
 # Agents from demonstrations (DAgger, configs/<ID>-dagger.yml), shipped as sac-dagger.
-# (configs/Sweeper-v1-dagger.yml is a trial, not shipped: docs/experiments/Sweeper-v1.md.)
 DAGGER_IDS ?= ExcavatorReach-v0 ExcavatorReach-v1 DualArmCell-v1 HarvestArm-v0 HarvestArmPlanar-v0
+# The same with a discrete, masked learner (maskableppo-dagger), shipped on the 20 held-out
+# episodes of the ID's other shipped model (BENCHMARKS compares them on the same episodes).
+MASKED_DAGGER_IDS ?= Sweeper-v1
 IDS ?= Sweeper-v0 Sweeper-v1 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 ExcavatorReach-v0 Excavator-v0
 # Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
 # as <algo>-residual.
@@ -107,6 +109,13 @@ models: $(STAMP)
 	      --config configs/$$id-dagger.yml --out runs/models-dagger || exit 1; \
 	  done; \
 	  $(BIN)/motiongym ship --episodes 100 runs/models-dagger/$$id/sac_seed* || exit 1; \
+	done
+	for id in $(MASKED_DAGGER_IDS); do \
+	  for seed in $(SEEDS); do \
+	    $(BIN)/motiongym train motiongym/$$id --seed $$seed \
+	      --config configs/$$id-dagger.yml --out runs/models-dagger || exit 1; \
+	  done; \
+	  $(BIN)/motiongym ship runs/models-dagger/$$id/maskableppo_seed* || exit 1; \
 	done
 
 # BENCHMARKS.md's tables and figures, from the shipped models' metrics.

@@ -60,6 +60,15 @@ imitate_kwargs the teacher's own keywords (mapping), e.g.              {}
 dagger_iterations learner-acting DAgger iterations after the          4
                teacher's (0: plain behaviour cloning)
 dagger_episodes episodes rolled out per DAgger iteration             50
+memory         a learner-side memory added to the observation:         null
+               ``sweeper_map`` (:mod:`motiongym.agents.map_memory`:
+               the robot's own map, built from its observations, as
+               robot-centred crops under the key ``memory``); the
+               training envs are wrapped with it and a loaded model
+               builds it from the observations it is given.
+               ``vec_env`` dummy or subproc; not with ``residual``
+memory_kwargs  the memory's settings (mapping): ``levels``, ``crop``,  {}
+               ``factor``
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its
@@ -81,6 +90,7 @@ import yaml
 from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
+from motiongym.agents.map_memory import MEMORIES, check_memory_kwargs
 from motiongym.agents.model_files import algorithm_classes
 from motiongym.envs.core import ArgumentError, check_bool, check_choice, check_float, check_int
 
@@ -105,6 +115,8 @@ RUN_SETTINGS: dict[str, Any] = {
     "imitate_kwargs": {},
     "dagger_iterations": 4,
     "dagger_episodes": 50,
+    "memory": None,
+    "memory_kwargs": {},
 }
 REQUIRED = ("n_timesteps", "policy")
 VEC_ENVS = ("dummy", "subproc", "native", "pettingzoo")
@@ -287,6 +299,7 @@ def _check_values(config: dict[str, Any], algorithm: type) -> None:
         )
     check_int("bc_epochs", config["bc_epochs"], 1, 100_000)
     _check_imitation(config)
+    _check_memory(config)
     if "log_std_init" in config["policy_kwargs"]:
         check_float("log_std_init", config["policy_kwargs"]["log_std_init"], -20.0, 20.0)
 
@@ -304,6 +317,22 @@ def _check_imitation(config: dict[str, Any]) -> None:
     check_int("dagger_episodes", config["dagger_episodes"], 1, 10**6)
     if config["n_timesteps"] == 0 and not (name or config["demonstrations"]):
         raise ArgumentError("n_timesteps 0 (no RL) needs imitate or demonstrations")
+
+
+def _check_memory(config: dict[str, Any]) -> None:
+    """``memory`` a name of :data:`~motiongym.agents.map_memory.MEMORIES`, its keywords
+    valid; in a dummy or subproc vec env (it wraps each env), not with ``residual``."""
+    name = config["memory"]
+    if name is None:
+        if config["memory_kwargs"]:
+            raise ArgumentError("memory_kwargs needs memory")
+        return
+    check_choice("memory", name, sorted(MEMORIES))
+    check_memory_kwargs(config["memory_kwargs"])
+    if config["vec_env"] not in ("dummy", "subproc"):
+        raise ArgumentError(f"memory needs vec_env dummy or subproc, got {config['vec_env']!r}")
+    if config["residual"] is not None:
+        raise ArgumentError("memory cannot be combined with residual")
 
 
 def _check_replay_buffer(config: dict[str, Any]) -> None:

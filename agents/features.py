@@ -156,6 +156,49 @@ class SweeperEgocentric(BaseFeaturesExtractor):
         return self.head(torch.cat(features, 1))
 
 
+class SweeperMapPyramid(BaseFeaturesExtractor):
+    """The sweeper's map memory (:mod:`motiongym.agents.map_memory`) through a small CNN.
+
+    Inputs, for a batch of ``B``: the memory's crops ``(3 L, n, n)``
+    (``todo``, ``obstacle``, ``unknown`` per pyramid level, robot-centred,
+    heading up; the levels are concentric, so they are stacked as channels,
+    as Active Neural SLAM stacks its local and global maps), through 3x3
+    convolutions with padding 1 (``channels``, ReLU after each), flattened;
+    and the bump flag (``pose[3]``). Nothing else of the observation is used:
+    the crops hold the windows' content, filed in the map, and the robot's
+    place in it (the centre); the pose's row and column do not enter, so the
+    policy is the same wherever a situation occurs.
+
+    Output: ``features_dim`` features (ReLU of a linear layer over the concatenation).
+    """
+
+    def __init__(
+        self,
+        observation_space: spaces.Dict,
+        features_dim: int = 128,
+        channels: Sequence[int] = (32, 32),
+    ) -> None:
+        super().__init__(observation_space, features_dim)
+        if "memory" not in observation_space.spaces:
+            raise ValueError(
+                "sweeper_map_pyramid needs the map memory in the observation "
+                "(a run with memory: sweeper_map)"
+            )
+        if not channels or not all(isinstance(n, int) and n > 0 for n in channels):
+            raise ValueError(f"channels must be positive integers, got {channels!r}")
+        depth, n, _ = observation_space["memory"].shape
+        layers: list[nn.Module] = []
+        for out_channels in channels:
+            layers += [nn.Conv2d(depth, out_channels, 3, padding=1), nn.ReLU()]
+            depth = out_channels
+        self.cnn = nn.Sequential(*layers, nn.Flatten())
+        self.head = nn.Sequential(nn.Linear(depth * n * n + 1, features_dim), nn.ReLU())
+
+    def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        features = (self.cnn(observations["memory"]), observations["pose"][:, 3:])
+        return self.head(torch.cat(features, 1))
+
+
 class ExcavatorFields(BaseFeaturesExtractor):
     """The named fields of an excavator observation, the rest dropped.
 
@@ -225,5 +268,6 @@ class ExcavatorFields(BaseFeaturesExtractor):
 # Names a config may give ``features_extractor_class`` -> the class.
 FEATURES_EXTRACTORS: dict[str, type[BaseFeaturesExtractor]] = {
     "sweeper_egocentric": SweeperEgocentric,
+    "sweeper_map_pyramid": SweeperMapPyramid,
     "excavator_fields": ExcavatorFields,
 }

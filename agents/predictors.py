@@ -27,7 +27,11 @@ episode_start, deterministic)``: a scripted policy from
   ``config.yml`` says ``deterministic: false`` samples its actions
   (:class:`SampledModel`) whatever its caller asks; one that says
   ``residual: <policy>`` adds its output to that scripted policy's
-  (:class:`~motiongym.agents.residual.ResidualPredictor`).
+  (:class:`~motiongym.agents.residual.ResidualPredictor`); one that says
+  ``memory: <name>`` was trained on observations with a memory added
+  (:mod:`motiongym.agents.map_memory`), which
+  :class:`~motiongym.agents.map_memory.MapMemoryPredictor` builds from the
+  observations it is given, reset at each episode's start.
 
 The algorithm of a bare ``.zip`` is read from the policy class saved in it
 (PPO and A2C share theirs, and either predicts the same way).
@@ -49,6 +53,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecNormalize
 
 from motiongym.agents.environments import resolved_env_kwargs
 from motiongym.agents.errors import UsageError
+from motiongym.agents.map_memory import MEMORIES, MapMemoryPredictor
 from motiongym.agents.model_files import (
     NORMALIZATION_FILE,
     PICKLED_NORMALIZATION,
@@ -267,8 +272,18 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
         predictor = SharedPolicyPredictor(_normalized(model, file, venv), venv.n_agents)
     else:
         what = f"the {env_id} environment"
-        model = load_archive(file, env.observation_space, env.action_space, what, kwargs)
-        predictor = _normalized(model, file, DummyVecEnv([lambda: env]))
+        memory = config.get("memory")
+        seen = env  # the environment as the model saw it in training
+        if memory:
+            try:
+                seen = MEMORIES[memory](env, **config["memory_kwargs"])
+            except ValueError as error:
+                raise UsageError(f"{file}: {error}") from None
+            what += f" with the {memory} memory"
+        model = load_archive(file, seen.observation_space, env.action_space, what, kwargs)
+        predictor = _normalized(model, file, DummyVecEnv([lambda: seen]))
+        if memory:
+            predictor = MapMemoryPredictor(predictor, env, **config["memory_kwargs"])
         if isinstance(model, MaskablePPO):
             predictor = MaskedModel(predictor, env)
     beside = (file.parent / NORMALIZATION_FILE, file.parent / PICKLED_NORMALIZATION)

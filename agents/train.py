@@ -14,6 +14,10 @@ A run writes one folder, ``<out>/<Name>-vN/<algo>_seed<seed>_<time>/``:
 * ``behaviour_cloning.json``: with ``demonstrations`` in the block, the
   mean loss of each cloning epoch (the policy is cloned before RL; with
   normalisation, its statistics are the demonstrations', frozen for the run);
+* with ``memory: <name>`` in the block, every environment (training, the
+  evaluation callback's, DAgger's) is wrapped with that memory
+  (:mod:`motiongym.agents.map_memory`), which adds its entry to the
+  observation; the loaders rebuild it from ``config.yml``;
 * ``dagger.json``: with ``imitate: <policy>`` in the block, each DAgger
   iteration's figures (:mod:`motiongym.agents.dagger`: the policy is taught
   by that scripted policy before RL, none with ``n_timesteps: 0``; with
@@ -70,6 +74,7 @@ from motiongym.agents.environments import (
 )
 from motiongym.agents.errors import UsageError
 from motiongym.agents.features import FEATURES_EXTRACTORS
+from motiongym.agents.map_memory import MEMORIES
 from motiongym.agents.model_files import (
     NORMALIZATION_FILE,
     algorithm_classes,
@@ -134,7 +139,17 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         venv.seed(seed)
         return _monitored(venv, monitor_dir, "native")
     vec_env_cls = SubprocVecEnv if config["vec_env"] == "subproc" and n_envs > 1 else DummyVecEnv
-    residual = config["residual"]
+    residual, memory = config["residual"], config["memory"]
+    wrapper_class, wrapper_kwargs = None, None
+    if residual:
+        wrapper_class = ResidualWrapper
+        wrapper_kwargs = {
+            "policy": residual,
+            "scale": config["residual_scale"],
+            "policy_kwargs": config["residual_kwargs"],
+        }
+    elif memory:  # the config's checks keep the two apart
+        wrapper_class, wrapper_kwargs = MEMORIES[memory], config["memory_kwargs"]
     return make_vec_env(
         importable_id(env_id),
         n_envs=n_envs,
@@ -142,14 +157,8 @@ def _vec_env(env_id: str, config: dict[str, Any], n_envs: int, seed: int, monito
         env_kwargs=config["env_kwargs"],
         monitor_dir=str(monitor_dir) if monitor_dir else None,
         vec_env_cls=vec_env_cls,
-        wrapper_class=ResidualWrapper if residual else None,
-        wrapper_kwargs={
-            "policy": residual,
-            "scale": config["residual_scale"],
-            "policy_kwargs": config["residual_kwargs"],
-        }
-        if residual
-        else None,
+        wrapper_class=wrapper_class,
+        wrapper_kwargs=wrapper_kwargs,
     )
 
 
@@ -183,6 +192,8 @@ def _imitate(env_id: str, config: dict[str, Any], model, venv, seed: int, run_di
     from motiongym.baselines import make_policy
 
     env = gym.make(env_id, **config["env_kwargs"])
+    if config["memory"]:  # the learner sees the memory; the teacher ignores the entry
+        env = MEMORIES[config["memory"]](env, **config["memory_kwargs"])
     try:
         teacher = make_policy(
             env_id,
