@@ -100,6 +100,44 @@ def test_the_features_do_not_depend_on_the_obstacles_slot_order(env_id, kwargs):
     assert not torch.allclose(extractor(moved), extractor(obs))
 
 
+def _turned(obs: torch.Tensor, layout, angle: float) -> torch.Tensor:
+    """The observation of the same scene and arm turned by ``angle`` about z (q_0 + angle)."""
+    s, d = layout.slices, layout.dim
+    c, sn = np.cos(angle), np.sin(angle)
+    turn = torch.eye(d, dtype=obs.dtype)
+    turn[:2, :2] = torch.tensor([[c, -sn], [sn, c]])
+    out = obs.clone()
+    for name in ("points", "fruit", "fruit_error"):
+        out[:, s[name]] = (obs[:, s[name]].reshape(len(obs), -1, d) @ turn.T).flatten(1)
+    rows = obs[:, s["obstacles"]].reshape(len(obs), layout.n_slots, -1).clone()
+    rows[..., :d] = rows[..., :d] @ turn.T
+    rows[..., d : 2 * d] = rows[..., d : 2 * d] @ turn.T
+    out[:, s["obstacles"]] = rows.flatten(1)
+    q0 = torch.atan2(obs[:, s["sin_q"].start], obs[:, s["cos_q"].start]) + angle
+    out[:, s["sin_q"].start], out[:, s["cos_q"].start] = torch.sin(q0), torch.cos(q0)
+    return out
+
+
+@pytest.mark.parametrize(("env_id", "kwargs"), VARIANTS)
+def test_in_the_waist_frame_a_scene_turned_with_the_arm_is_the_same_input(env_id, kwargs):
+    env, obs = _batch(env_id)
+    obs = obs.double()
+    turned = _turned(obs, env.unwrapped.layout, 0.7)
+    # The turned observation is the environment's own: same clearances, same layout.
+    q = np.arctan2(*(turned[0, env.unwrapped.layout.slices[k]].numpy() for k in ("sin_q", "cos_q")))
+    env.unwrapped.world.pose(q)
+    np.testing.assert_allclose(
+        env.unwrapped.world.points.ravel(),
+        turned[0, env.unwrapped.layout.slices["points"]].numpy(),
+        atol=1e-6,
+    )
+    torch.manual_seed(0)
+    extractor = HarvestObstacleSet(env.observation_space, **kwargs).double()
+    torch.testing.assert_close(extractor(turned), extractor(obs))
+    world = HarvestObstacleSet(env.observation_space, waist_frame=False, **kwargs).double()
+    assert not torch.allclose(world(turned), world(obs))
+
+
 def test_empty_slots_do_not_count():
     env, obs = _batch("motiongym/HarvestArmPlanar-v0")
     extractor = HarvestObstacleSet(env.observation_space, planar=True)
@@ -123,6 +161,8 @@ def test_bad_keywords_and_a_foreign_observation_are_refused_by_name():
         HarvestObstacleSet(planar)
     with pytest.raises(ValueError, match="hidden must be a positive integer, got 0"):
         HarvestObstacleSet(planar, planar=True, hidden=0)
+    with pytest.raises(ValueError, match="waist_frame must be true or false, got 'yes'"):
+        HarvestObstacleSet(planar, planar=True, waist_frame="yes")
 
 
 def test_a_dagger_config_naming_it_trains_and_the_model_evaluates(tmp_path):
