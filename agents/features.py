@@ -16,6 +16,9 @@ scripted policies see, in another frame, and remembers nothing.
 
 :class:`ExcavatorFields` keeps the named fields of an excavator observation
 (``excavator_fields`` with ``fields: [q, target_error, ...]``).
+
+:class:`motiongym.agents.obstacle_sets.HarvestObstacleSet` (``harvest_obstacle_set``)
+pools shared per-obstacle networks over the harvest arm's obstacle slots.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from gymnasium import spaces
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
+from motiongym.agents.obstacle_sets import HarvestObstacleSet
 from motiongym.envs.excavator.observation import layout
 
 
@@ -270,4 +274,5 @@ FEATURES_EXTRACTORS: dict[str, type[BaseFeaturesExtractor]] = {
     "sweeper_egocentric": SweeperEgocentric,
     "sweeper_map_pyramid": SweeperMapPyramid,
     "excavator_fields": ExcavatorFields,
+    "harvest_obstacle_set": HarvestObstacleSet,
 }
