@@ -84,6 +84,9 @@ IDS ?= Sweeper-v0 Sweeper-v1 HarvestArm-v0 HarvestArmPlanar-v0 DualArmCell-v0 Ex
 # Residual agents (configs/<ID>-residual.yml: a correction of the scripted policy), shipped
 # as <algo>-residual.
 RESIDUAL_IDS ?= Excavator-v1 Excavator-v0 ExcavatorReach-v1
+# Goal-conditioned agents from scratch (configs/<ID>.yml's first block: SAC + hindsight
+# experience replay), shipped as sac on 100 held-out episodes.
+GOAL_IDS ?= ExcavatorReachGoal-v1
 models: $(STAMP)
 	for id in $(IDS); do \
 	  for seed in $(SEEDS); do \
@@ -116,6 +119,12 @@ models: $(STAMP)
 	      --config configs/$$id-dagger.yml --out runs/models-dagger || exit 1; \
 	  done; \
 	  $(BIN)/motiongym ship runs/models-dagger/$$id/maskableppo_seed* || exit 1; \
+	done
+	for id in $(GOAL_IDS); do \
+	  for seed in $(SEEDS); do \
+	    $(BIN)/motiongym train motiongym/$$id --seed $$seed --out runs/models-goal || exit 1; \
+	  done; \
+	  $(BIN)/motiongym ship --episodes 100 runs/models-goal/$$id/*_seed* || exit 1; \
 	done
 
 # BENCHMARKS.md's tables and figures, from the shipped models' metrics.

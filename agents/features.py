@@ -19,6 +19,10 @@ scripted policies see, in another frame, and remembers nothing.
 
 :class:`motiongym.agents.obstacle_sets.HarvestObstacleSet` (``harvest_obstacle_set``)
 pools shared per-obstacle networks over the harvest arm's obstacle slots.
+
+:class:`GoalError` adds the goal error ``desired - achieved`` (and squashed copies
+of it) to a goal-conditioned observation (``goal_error``, for the goal IDs of
+:mod:`motiongym.envs.goal` and hindsight experience replay).
 """
 
 from __future__ import annotations
@@ -269,10 +273,82 @@ class ExcavatorFields(BaseFeaturesExtractor):
         return torch.cat([selected, torch.tanh(error / self.scales)], 1)
 
 
+class GoalError(BaseFeaturesExtractor):
+    """A goal ``Dict`` observation with its goal error made explicit.
+
+    Input: ``observation``, ``achieved_goal``, ``desired_goal`` (a goal ID of
+    :mod:`motiongym.envs.goal`), raw (``normalize: false``: the squashing
+    below is in the goal's own units, m and rad). Output, concatenated: the
+    ``observation`` entries at ``keep`` (default all), ``achieved_goal``,
+    ``desired_goal``, the error ``e = desired - achieved`` (components at
+    ``angles`` wrapped to [-pi, pi], as the env's success test), and for each
+    ``s`` of ``error_scales``, ``tanh(e / s)``.
+
+    Every output is a function of the observation and the two goals, so a
+    transition relabelled by HER (another ``desired_goal``) gets the
+    features of that goal: the extractor is consistent with relabelling.
+    Why the error and its squashed copies: the goal env drops the base
+    task's ``target_error`` (it depends on the goal), and a success
+    tolerance of 5 cm on a 10 m reach is a difference of two inputs in
+    metres; :class:`ExcavatorFields` gives the same reason and its measure
+    for the non-goal reach, and ``docs/experiments/ExcavatorReachGoal-v1.md``
+    the measure for this one.
+    """
+
+    def __init__(
+        self,
+        observation_space: spaces.Dict,
+        keep: Sequence[int] | None = None,
+        angles: Sequence[int] = (),
+        error_scales: Sequence[float] = (),
+    ) -> None:
+        keys = ("observation", "achieved_goal", "desired_goal")
+        if not isinstance(observation_space, spaces.Dict) or set(observation_space.spaces) != set(
+            keys
+        ):
+            raise ValueError(
+                f"goal_error needs a Dict observation of {keys}, got {observation_space}"
+            )
+        n_obs = observation_space["observation"].shape[0]
+        size = observation_space["desired_goal"].shape[0]
+        kept = list(range(n_obs)) if keep is None else list(keep)
+        if not all(isinstance(i, int) and 0 <= i < n_obs for i in kept):
+            raise ValueError(
+                f"keep must be indices of the {n_obs} observation entries, got {keep!r}"
+            )
+        if not all(isinstance(i, int) and 0 <= i < size for i in angles):
+            raise ValueError(f"angles must be indices of the {size} goal entries, got {angles!r}")
+        scales = tuple(error_scales)
+        if not all(isinstance(x, (int, float)) and x > 0 for x in scales):
+            raise ValueError(f"error_scales must be positive numbers, got {error_scales!r}")
+        super().__init__(observation_space, len(kept) + size * (3 + len(scales)))
+        self.register_buffer("keep", torch.tensor(kept, dtype=torch.long))
+        wrap = torch.zeros(size, dtype=torch.bool)
+        wrap[list(angles)] = True
+        self.register_buffer("wrap", wrap)
+        self.register_buffer(
+            "scales", torch.tensor(scales, dtype=torch.float32).repeat_interleave(size)
+        )
+
+    def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        achieved, desired = observations["achieved_goal"], observations["desired_goal"]
+        error = desired - achieved
+        error = torch.where(
+            self.wrap, torch.remainder(error + math.pi, 2 * math.pi) - math.pi, error
+        )
+        parts = [observations["observation"][:, self.keep], achieved, desired, error]
+        if len(self.scales):
+            parts.append(
+                torch.tanh(error.repeat(1, len(self.scales) // error.shape[1]) / self.scales)
+            )
+        return torch.cat(parts, 1)
+
+
 # Names a config may give ``features_extractor_class`` -> the class.
 FEATURES_EXTRACTORS: dict[str, type[BaseFeaturesExtractor]] = {
     "sweeper_egocentric": SweeperEgocentric,
     "sweeper_map_pyramid": SweeperMapPyramid,
     "excavator_fields": ExcavatorFields,
     "harvest_obstacle_set": HarvestObstacleSet,
+    "goal_error": GoalError,
 }
