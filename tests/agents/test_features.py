@@ -140,9 +140,11 @@ def test_an_unknown_extractor_name_lists_the_known_ones(tmp_path):
         "ppo:\n  n_timesteps: 10\n  policy: MultiInputPolicy\n"
         "  policy_kwargs: {features_extractor_class: NatureCNN}\n"
     )
-    with pytest.raises(
-        UsageError, match="'NatureCNN' unknown; valid: sweeper_egocentric, excavator_fields"
-    ):
+    valid = (
+        "sweeper_egocentric, sweeper_map_pyramid, excavator_fields, harvest_obstacle_set, "
+        "goal_error"
+    )
+    with pytest.raises(UsageError, match=f"'NatureCNN' unknown; valid: {valid}"):
         train(SWEEPER, "ppo", config_path=config, out_root=tmp_path)
 
 
