@@ -28,9 +28,16 @@ The rules:
   Salmond & Smith 1993): with exact moves the particles differ only by
   their heading error, resampling leaves a few tracks, and a pose error
   that none of them holds is never repaired (heading noise alone:
-  docs/experiments/Sweeper-v1.md); a bump leaves it where it was, and weighs down
-  the particles whose move would have found a footprint the map holds free
-  (``exp(-BLOCKED)``).
+  docs/experiments/Sweeper-v1.md); with ``diffusion`` a forward move also
+  adds ``N(0, diffusion)`` to each particle's ``e`` (the policy passes the
+  heading noise: the particles' heading noise on a move is doubled in
+  variance, process-noise inflation against sample impoverishment, Thrun,
+  Burgard & Fox 2005, 4.3.4: after resampling the particles' heading errors
+  are copies of a few, and a heading error none of them holds is otherwise
+  reached only by the spec's own noise, 0.01 rad per action, while every move
+  at the wrong heading files the map further off); a bump leaves it where it
+  was, and weighs down the particles whose move would have found a footprint
+  the map holds free (``exp(-BLOCKED)``).
 - **Weight.** Over the window's cells sensed now (``known``; all in v0)
   and known in the map (cells the map holds only from a bump do not
   count): each disagreement multiplies a particle's weight by
@@ -64,12 +71,21 @@ class Localiser:
         heading_noise, slip_noise: the odometry spec (rad per action, relative).
         n: particles.
         seed: of the filter's own random generator (same seed, same run).
+        diffusion: extra heading-error std per forward move (rad; see the docstring).
     """
 
     def __init__(
-        self, w: int, R: int, heading_noise: float, slip_noise: float, n: int = 256, seed: int = 0
+        self,
+        w: int,
+        R: int,
+        heading_noise: float,
+        slip_noise: float,
+        n: int = 256,
+        seed: int = 0,
+        diffusion: float = 0.0,
     ) -> None:
         self.w, self.R, self.S = w, R, w + 2 * R
+        self.diffusion = diffusion
         self.sh, self.ss, self.n = heading_noise, max(slip_noise, MIN_SLIP), n
         self.rng = np.random.default_rng(seed)
         # (n,) particle states (row, column, heading error), set at the first observation
@@ -102,10 +118,17 @@ class Localiser:
         self._estimate()
         return self.cell
 
+    def observe(self, robot_map: RobotMap, obs: dict) -> tuple[int, int, int, bool]:
+        """Locate, then write the observation into ``robot_map`` at the estimate; return
+        ``(row, col, heading, bump)`` (:meth:`.belief.RobotMap.integrate`)."""
+        return robot_map.integrate(obs, self.locate(robot_map, obs))
+
     def _move(self, moved: bool, h: int) -> None:
         n = self.n
         self.e += self.rng.normal(0.0, self.sh, n) if self.sh else 0.0
         if moved:
+            if self.diffusion:
+                self.e += self.rng.normal(0.0, self.diffusion, n)
             d = 1.0 + (self.rng.normal(0.0, self.ss, n) if self.ss else 0.0)
             d = np.clip(d, 0.0, MAX_SLIP)
             angle = h * math.pi / 2 + self.e
@@ -160,6 +183,16 @@ class Localiser:
         mass = np.bincount(inv.ravel(), weights=self.wt, minlength=len(uniq))
         best = uniq[int(np.argmax(mass))]
         self.cell = int(best[0]), int(best[1])
+
+    def continuous(self) -> tuple[float, float, float]:
+        """``(y, x, e)``: the weighted mean position of the particles in the estimated cell
+        and the weighted mean heading error of all."""
+        at = (np.rint(self.y) == self.cell[0]) & (np.rint(self.x) == self.cell[1])
+        wt = self.wt * at if at.any() else self.wt
+        if wt.sum() <= 0:
+            wt = at.astype(float)
+        e = float(np.average(self.e, weights=self.wt))
+        return float(np.average(self.y, weights=wt)), float(np.average(self.x, weights=wt)), e
 
     @property
     def spread(self) -> float:

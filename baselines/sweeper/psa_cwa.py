@@ -22,7 +22,14 @@ the robot to the nearest of them, up to :data:`MAX_STALLS` times in a row.
 A bump where the map holds the footprint ahead free (the continuous pose,
 drifted by the heading error, rounds into the wall beside the path) sends
 the robot one cell sideways, against the estimated drift, and its bump
-marks become unknown, not walls, once it has moved on.
+marks become unknown, not walls, once it has moved on. Three mechanisms act
+under noise, each with its ablation here: a map per particle
+(:mod:`.fastslam`, grid FastSLAM; :class:`PsaCwaOneMapPolicy` files every
+window into one map at the estimate), steering by the estimated heading
+error (:mod:`.drift`, :mod:`.steer`; ``steering``) and heading-error
+diffusion of the particles on forward moves (``diffuse``); measured in
+``docs/experiments/Sweeper-v1.md`` (fourth pass) and
+``tests/baselines/test_sweeper_localise.py``.
 :class:`PsaCwaDeadReckoningPolicy` is the ablation that trusts the
 dead-reckoned pose; :class:`PsaCwaBfsTransferPolicy` the one that moves
 between runs along the shortest path over all known free configurations
@@ -43,6 +50,8 @@ from gymnasium import spaces
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper import cwa, psa, quadtree
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
+from motiongym.baselines.sweeper.drift import DIRECTION, DriftActing
+from motiongym.baselines.sweeper.fastslam import ParticleMaps
 from motiongym.baselines.sweeper.localise import Localiser
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.occupancy import DC, DR
@@ -51,6 +60,10 @@ from motiongym.envs.sweeper.params import SweeperParams
 FORWARD, LEFT, RIGHT = 0, 1, 2
 EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
 MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
+# rounds of mode changes one step may take (without noise 3 at most on the shipped maps,
+# under noise 15 where it settles; a loop that does not settle repeats itself)
+MAX_ROUNDS = 50
+PARTICLE_VOTES = 100  # votes a cell of a particle's map holds at most (fastslam.py)
 
 
 def turn_towards(heading: int, target: int) -> int:
@@ -93,10 +106,12 @@ class Memory:
     stalls: int = 0  # scans in a row that found the same leftovers (each sends it to the nearest)
     started: bool = False
     last_pose: tuple[int, int] | None = None
+    heading: int = 0  # the commanded heading of the last observation
+    blocked: set = field(default_factory=set)  # commanded headings that bumped from this cell
     log: list = field(default_factory=list)  # (mode, pose) at each decision, for figures
 
 
-class PsaCwaPolicy(ScriptedPolicy):
+class PsaCwaPolicy(DriftActing, ScriptedPolicy):
     """PSA with a LIFO stack, quadtree transfers, then CWA (paper section 3)."""
 
     pop_order = "lifo"  # "lifo": LIFO by runs; "stack": the top entry; "nearest": any entry
@@ -113,6 +128,10 @@ class PsaCwaPolicy(ScriptedPolicy):
     max_stalls = 0  # scans without progress before done (localising: MAX_STALLS)
     evidence = EVIDENCE  # map votes when localising (0: the latest window wins)
     sidestep = True  # localising: step aside after a bump the map does not explain
+    steering = True  # localising: steer by the estimated heading error (drift.py)
+    particle_maps = True  # localising: a map per particle (fastslam.py); False: one map
+    map_votes = PARTICLE_VOTES  # with particle_maps: votes a cell holds at most
+    diffuse = True  # localising: heading-error diffusion on moves (localise.py)
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -125,7 +144,14 @@ class PsaCwaPolicy(ScriptedPolicy):
         p = self.params
         if not (self.localise and p.noisy):
             return Memory(RobotMap(self.w, self.R))
-        loc = Localiser(self.w, self.R, p.heading_noise, p.slip_noise)
+        spec = (self.w, self.R, p.heading_noise, p.slip_noise)
+        diffusion = p.heading_noise if self.diffuse else 0.0
+        loc: Localiser
+        if self.particle_maps:
+            votes = self.map_votes if self.evidence else 1  # 1: the latest window wins
+            loc = ParticleMaps(*spec, diffusion=diffusion, evidence=votes)
+        else:
+            loc = Localiser(*spec, diffusion=diffusion)
         return Memory(RobotMap(self.w, self.R, self.evidence), loc)
 
     def describe(self, memory: Memory) -> dict[str, Any]:
@@ -148,64 +174,36 @@ class PsaCwaPolicy(ScriptedPolicy):
         m = memory
         m.steps += 1
         if m.loc is not None:
-            cell = m.loc.locate(m.map, observation)
-            r, c, h, bump = m.map.integrate(observation, cell)
+            r, c, h, bump = m.loc.observe(m.map, observation)
         else:
             r, c, h, bump = m.map.integrate(observation)
         if not m.started:
             m.started = True
             m.run_heading, m.run_side = h, psa.right_of(h)
             m.lane_start = (r, c)
-        if bump:  # the cells ahead are blocked, whatever the map said
-            unexplained = m.loc is not None and self.sidestep and self._ahead_free(m, r, c, h)
-            self._mark_ahead(m, r, c, h)
-            m.path.clear()
-            if unexplained:
-                self._sidestep(m, r, c, h)
-        elif (r, c) != m.last_pose and m.map.felt.any():
-            # moved on: bump marks were for where it stood (localising: unknown until seen
-            # again, so that a bump the map did not explain leaves no wall behind)
-            m.map.forget_felt(unmark=m.loc is not None and self.sidestep)
-        m.last_pose = (r, c)
-        for _ in range(200):
+        self._bumped(m, r, c, h, bump)
+        for _ in range(MAX_ROUNDS):
             a = self._follow(m, r, c, h)
             if a is not None:
                 return a
             a = getattr(self, "_" + m.mode)(m, r, c, h)
             if a is not None:
                 return a
-        return LEFT  # pragma: no cover - a planning loop that does not settle
-
-    def _ahead_free(self, m: Memory, r: int, c: int, h: int) -> bool:
-        """True when the map holds no obstacle in the footprint one move ahead."""
-        occ, _ = m.map.footprint(r + int(DR[h]), c + int(DC[h]))
-        return not (occ == OBSTACLE).any()
-
-    def _sidestep(self, m: Memory, r: int, c: int, h: int) -> None:
-        """After a bump the map does not explain: one cell sideways, against the drift.
-
-        The true heading is ``h`` turned by the heading error ``e``, so a move
-        drifts to the left of ``h`` when ``e > 0``; the robot's continuous
-        position can sit just short of the next cell across, and every move
-        ahead then rounds into the wall beside the path (the same bump for
-        ever). A step to the side away from the drift (the localiser's
-        weighted mean ``e``) takes it off that line.
-        """
-        e = float(np.average(m.loc.e, weights=m.loc.wt)) if m.loc is not None else 0.0
-        first = psa.right_of(h) if e > 0 else psa.left_of(h)
-        for s in (first, (first + 2) % 4):
-            cell = (r + int(DR[s]), c + int(DC[s]))
-            occ, _ = m.map.footprint(*cell)
-            if not (occ == OBSTACLE).any():
-                m.path = deque([cell])
-                return
-
-    def _mark_ahead(self, m: Memory, r: int, c: int, h: int) -> None:
-        rr, cc = np.nonzero(occupancy.entering_mask(int(DR[h]), int(DC[h]), self.w))
-        m.map.mark_obstacle(rr + r + int(DR[h]), cc + c + int(DC[h]))
+        # The modes did not settle: under odometry error, a plan whose every way on bumped
+        # from here, replanned the same from a map that still holds it free. Move on in a
+        # heading that has not bumped from this cell (a new cell clears the bumps), else
+        # turn; when all four have bumped, the bumps were felt at other true positions
+        # (slips that left the estimated cell unchanged) and are forgotten.
+        m.path.clear()
+        if len(m.blocked) == 4:
+            m.blocked.clear()
+        return FORWARD if h not in m.blocked else LEFT
 
     def _follow(self, m: Memory, r: int, c: int, h: int) -> int | None:
         """Execute the planned path of configurations (turn towards, then forward)."""
+        if (r, c) in list(m.path)[1:3]:  # a diagonal move (under odometry error) skipped one
+            while m.path[0] != (r, c):
+                m.path.popleft()
         while m.path and m.path[0] == (r, c):
             m.path.popleft()
         if not m.path:
@@ -215,7 +213,12 @@ class PsaCwaPolicy(ScriptedPolicy):
         if abs(nr - r) + abs(nc - c) != 1 or (occ == OBSTACLE).any():
             m.path.clear()  # blocked or off the path: the mode replans
             return None
-        d = {(0, 1): 0, (-1, 0): 1, (0, -1): 2, (1, 0): 3}[(nr - r, nc - c)]
+        if m.loc is not None and self.steering:
+            a = self._steered(m, r, c, list(m.path))
+            if a is None:  # every way towards it bumped here: the mode replans
+                m.path.clear()
+            return a
+        d = DIRECTION[(nr - r, nc - c)]
         return FORWARD if d == h else turn_towards(h, d)
 
     def _known(self, m: Memory, r: int, c: int):
@@ -236,13 +239,20 @@ class PsaCwaPolicy(ScriptedPolicy):
     # -------------------------------------------------------------- PSA modes
     def _lane(self, m: Memory, r: int, c: int, h: int) -> int | None:
         assert m.run_heading is not None and m.run_side is not None, "set before a lane"
-        if h != m.run_heading:
+        steering = m.loc is not None and self.steering
+        if steering:  # the lane's heading in the map; steer picks the command
+            h = m.run_heading
+        elif h != m.run_heading:
             return turn_towards(h, m.run_heading)
         nr, nc = r + int(DR[h]), c + int(DC[h])
         occ, sw = m.map.footprint(nr, nc)
         edge = occupancy.entering_mask(int(DR[h]), int(DC[h]), self.w)
         if psa.lane_open(occ, sw[edge]):
-            return FORWARD  # step 1: straight on, sweeping
+            if not steering:
+                return FORWARD  # step 1: straight on, sweeping
+            a = self._steered(m, r, c, [(nr, nc)])
+            if a is not None:
+                return a  # else the lane ends here: every way on bumped
         assert m.lane_start is not None, "set before a lane"
         for seg in psa.side_segments(m.lane_start, (r, c), h, self.w):  # steps 2-3
             if self._strip_unswept(m, seg):
@@ -570,6 +580,13 @@ class PsaCwaDeadReckoningPolicy(PsaCwaPolicy):
     of the localiser (:mod:`.localise`), as the policy was before it."""
 
     localise = False
+
+
+class PsaCwaOneMapPolicy(PsaCwaPolicy):
+    """PSA + CWA localised on one map filed at the estimate (Monte Carlo localisation,
+    :mod:`.localise`): the ablation of the map per particle (:mod:`.fastslam`)."""
+
+    particle_maps = False
 
 
 class PsaCwaBfsTransferPolicy(PsaCwaPolicy):

@@ -10,7 +10,11 @@ import motiongym  # noqa: F401
 from motiongym.agents.evaluate import run_episode
 from motiongym.baselines.sweeper.belief import RobotMap
 from motiongym.baselines.sweeper.localise import Localiser
-from motiongym.baselines.sweeper.psa_cwa import PsaCwaDeadReckoningPolicy, PsaCwaPolicy
+from motiongym.baselines.sweeper.psa_cwa import (
+    PsaCwaDeadReckoningPolicy,
+    PsaCwaOneMapPolicy,
+    PsaCwaPolicy,
+)
 from motiongym.envs.sweeper import generator
 
 ENV_ID = "motiongym/Sweeper-v1"
@@ -142,15 +146,17 @@ def test_a_move_is_read_from_the_heading_not_the_clipped_reckoning() -> None:
 
 
 def test_localised_beats_dead_reckoning_on_the_room() -> None:
-    # measured (seeds 0-3, quadtree transfers): localised 98.8 / 97.7 / 99.9 / 99.4 %, dead
-    # reckoning 97.2 / 64.1 / 92.9 / 96.9 % (mean 87.8 %): one seed alone does not separate them
+    # measured (seeds 0-3, a map per particle): localised 99.6 / 100 (the environment ends on
+    # full coverage before the policy declares done) / 99.7 / 99.1 %, dead reckoning 97.2 /
+    # 64.1 / 92.9 / 96.9 % (mean 87.8 %): one seed alone does not separate them
     loc, dead = [], []
     for seed in range(4):
         cov, done = coverage_at_done(PsaCwaPolicy, seed, map_name="room", **NOISE)
         loc.append(cov)
-        cov, dead_done = coverage_at_done(PsaCwaDeadReckoningPolicy, seed, map_name="room", **NOISE)
+        assert done or cov == 1.0
+        cov, done = coverage_at_done(PsaCwaDeadReckoningPolicy, seed, map_name="room", **NOISE)
         dead.append(cov)
-        assert done and dead_done
+        assert done or cov == 1.0
     assert min(loc) > 0.97 and np.mean(dead) < 0.9
     assert all(a > b for a, b in zip(loc, dead, strict=True))
 
@@ -158,7 +164,7 @@ def test_localised_beats_dead_reckoning_on_the_room() -> None:
 @pytest.mark.slow
 def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
     """L, office, spiral (written here, never tuned on), seeds 0-2; measured mean (min):
-    97.4 % (82.8 %) localised, 62.1 % (24.8 %) dead reckoning."""
+    99.2 % (97.6 %) localised (a map per particle), 62.1 % (24.8 %) dead reckoning."""
     ours, ablation = [], []
     for make in (l_shape, office, spiral):
         for seed in range(3):
@@ -174,9 +180,9 @@ def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
 def test_localised_beats_dead_reckoning_on_new_unseen_maps() -> None:
     """Corridors, pillars, generator maps from fresh seeds (apartment 4242, room 4243,
     maze 4244), seeds 0-1, heading 0.01 + slip 0.05. Measured, coverage at done:
-    localised 97.6 % mean, 91.4 % min; dead reckoning 80.6 %, 8.6 %. Seeds 0-6 of
-    these five maps and the L, office and spiral (56 runs): 98.4 % mean, 86.1 % min
-    (docs/experiments/Sweeper-v1.md, third pass); the issue's 99 / 97 % is not met."""
+    localised 99.7 % mean, 99.2 % min; dead reckoning 80.6 %, 8.6 %. Seeds 0-6 of
+    these five maps and the L, office and spiral (56 runs): 99.3 % mean, 93.0 % min
+    (docs/experiments/Sweeper-v1.md, fourth pass); the issue's 97 % minimum is not met."""
     ours, ablation = [], []
     for make in NEW_UNSEEN.values():
         for seed in range(2):
@@ -184,7 +190,7 @@ def test_localised_beats_dead_reckoning_on_new_unseen_maps() -> None:
             ablation.append(
                 coverage_at_done(PsaCwaDeadReckoningPolicy, seed, grid=make(), **NOISE)[0]
             )
-    assert np.mean(ours) > 0.97 and np.min(ours) > 0.9
+    assert np.mean(ours) > 0.99 and np.min(ours) > 0.97
     assert np.mean(ours) > np.mean(ablation) + 0.1
 
 
@@ -202,6 +208,18 @@ class NoStalls(PsaCwaPolicy):
         self.max_stalls = 0
 
 
+class NoSteer(PsaCwaPolicy):
+    """Ablation: turn to the next cell's direction and move forward, as without noise."""
+
+    steering = False
+
+
+class NoDiffuse(PsaCwaPolicy):
+    """Ablation: no heading-error diffusion of the particles on a forward move."""
+
+    diffuse = False
+
+
 class NoSidestep(PsaCwaPolicy):
     """Ablation: after a bump the map does not explain, replan from the same spot (and
     the bump marks stay walls once it moves on)."""
@@ -209,19 +227,51 @@ class NoSidestep(PsaCwaPolicy):
     sidestep = False
 
 
+LOS = (l_shape, office, spiral)
+OPEN = (office, NEW_UNSEEN["pillars"], NEW_UNSEEN["corridors"], spiral)
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("ablation", [NoVotes, NoStalls, NoSidestep, PsaCwaDeadReckoningPolicy])
-def test_each_mechanism_earns_its_place(ablation) -> None:
-    """L, office, spiral (unseen), seeds 0-2, heading 0.01 + slip 0.05; measured mean (min)
-    coverage at done with quadtree transfers: 99.0 % (97.9 %) with all; 93.2 % (67.4 %)
-    without votes; 97.0 % (85.8 %) without the stall rule; 90.9 % (66.3 %) without the
-    sidestep. On the shipped maps (room, apartment, maze, seeds 0-2) the stall rule
-    changes nothing measurable since the quadtree transfers (97.6 % both), so this test
-    runs where each mechanism is at work."""
+@pytest.mark.parametrize(
+    ("ablation", "maps"),
+    [
+        (NoVotes, LOS),
+        (NoStalls, LOS),
+        (NoSidestep, LOS),
+        (PsaCwaDeadReckoningPolicy, LOS),
+        (PsaCwaOneMapPolicy, LOS),
+        (NoSteer, LOS),
+        (NoDiffuse, OPEN),
+    ],
+)
+def test_each_mechanism_earns_its_place(ablation, maps) -> None:
+    """Seeds 0-2, heading 0.01 + slip 0.05, coverage at done; measured mean (min), all
+    mechanisms against the ablation (docs/experiments/Sweeper-v1.md, fourth pass): on L,
+    office, spiral 99.2 % (97.6 %) against one map for all particles 96.6 % (77.2 %),
+    no steering 93.3 % (55.2 %); on office, pillars, corridors, spiral 99.8 % (99.3 %)
+    against no diffusion 93.8 % (50.4 %). Each mechanism is tested where it is at work."""
     ours, theirs = [], []
-    for make in (l_shape, office, spiral):
+    for make in maps:
         for seed in range(3):
             ours.append(coverage_at_done(PsaCwaPolicy, seed, grid=make(), **NOISE)[0])
             theirs.append(coverage_at_done(ablation, seed, grid=make(), **NOISE)[0])
     assert np.mean(ours) > np.mean(theirs) + 0.01
     assert np.min(ours) > np.min(theirs)
+
+
+def test_a_step_whose_planning_does_not_settle_moves_on() -> None:
+    """Room, slip 0.1, seed 0: every heading had bumped from the estimated cell (slips moved
+    the robot, not the estimate) and the modes replanned the same path for ever, turning in
+    place (over 10 min without an end). With MAX_ROUNDS and the bumps forgotten it sweeps
+    the room in under 1,000 steps."""
+    kwargs = {"map_name": "room", "heading_noise": 0.0, "slip_noise": 0.1}
+    env = gym.make(ENV_ID, **kwargs)
+    policy = PsaCwaPolicy(env.observation_space, env.action_space, kwargs)
+    seen = {"steps": 0}
+
+    def hook(step) -> bool:
+        seen["steps"], seen["coverage"] = step.index + 1, step.info["coverage"]
+        return policy.diagnostics()["done"] or seen["steps"] >= 3000
+
+    run_episode(env, policy, 0, hook=hook)
+    assert seen["coverage"] == 1.0 and seen["steps"] < 1000
