@@ -58,7 +58,7 @@ class ParticleMaps(Localiser):
         n: int = 256,
         seed: int = 0,
         diffusion: float = 0.0,
-        evidence: int = 100,
+        evidence: int = 4,
     ) -> None:
         super().__init__(w, R, heading_noise, slip_noise, n, seed, diffusion)
         self.evidence = evidence

@@ -63,7 +63,9 @@ MAX_STALLS = 20  # scans without progress a localising policy makes before it de
 # rounds of mode changes one step may take (without noise 3 at most on the shipped maps,
 # under noise 15 where it settles; a loop that does not settle repeats itself)
 MAX_ROUNDS = 50
-PARTICLE_VOTES = 100  # votes a cell of a particle's map holds at most (fastslam.py)
+# votes a cell of a particle's map holds at most (fastslam.py): EVIDENCE, as the one map's;
+# 1 (the latest window wins) and 100 measured worse (docs/experiments/Sweeper-v1.md)
+PARTICLE_VOTES = EVIDENCE
 
 
 def turn_towards(heading: int, target: int) -> int:

@@ -146,9 +146,8 @@ def test_a_move_is_read_from_the_heading_not_the_clipped_reckoning() -> None:
 
 
 def test_localised_beats_dead_reckoning_on_the_room() -> None:
-    # measured (seeds 0-3, a map per particle): localised 99.6 / 100 (the environment ends on
-    # full coverage before the policy declares done) / 99.7 / 99.1 %, dead reckoning 97.2 /
-    # 64.1 / 92.9 / 96.9 % (mean 87.8 %): one seed alone does not separate them
+    # measured (seeds 0-3, a map per particle): localised 99.7 / 99.9 / 99.3 / 99.2 %, dead
+    # reckoning 97.2 / 64.1 / 92.9 / 96.9 % (mean 87.8 %): one seed alone does not separate them
     loc, dead = [], []
     for seed in range(4):
         cov, done = coverage_at_done(PsaCwaPolicy, seed, map_name="room", **NOISE)
@@ -235,7 +234,7 @@ OPEN = (office, NEW_UNSEEN["pillars"], NEW_UNSEEN["corridors"], spiral)
 @pytest.mark.parametrize(
     ("ablation", "maps"),
     [
-        (NoVotes, LOS),
+        (NoVotes, OPEN),
         (NoStalls, LOS),
         (NoSidestep, LOS),
         (PsaCwaDeadReckoningPolicy, LOS),
@@ -263,15 +262,17 @@ def test_a_step_whose_planning_does_not_settle_moves_on() -> None:
     """Room, slip 0.1, seed 0: every heading had bumped from the estimated cell (slips moved
     the robot, not the estimate) and the modes replanned the same path for ever, turning in
     place (over 10 min without an end). With MAX_ROUNDS and the bumps forgotten it sweeps
-    the room in under 1,000 steps."""
+    the room (99.9 %) and declares itself done in under 1,000 steps."""
     kwargs = {"map_name": "room", "heading_noise": 0.0, "slip_noise": 0.1}
     env = gym.make(ENV_ID, **kwargs)
     policy = PsaCwaPolicy(env.observation_space, env.action_space, kwargs)
-    seen = {"steps": 0}
+    seen = {"steps": 0, "done": False}
 
     def hook(step) -> bool:
         seen["steps"], seen["coverage"] = step.index + 1, step.info["coverage"]
-        return policy.diagnostics()["done"] or seen["steps"] >= 3000
+        seen["done"] = policy.diagnostics()["done"]
+        return seen["done"] or seen["steps"] >= 3000
 
     run_episode(env, policy, 0, hook=hook)
-    assert seen["coverage"] == 1.0 and seen["steps"] < 1000
+    assert (seen["done"] or seen["coverage"] == 1.0) and seen["steps"] < 1000
+    assert seen["coverage"] > 0.99
