@@ -60,12 +60,8 @@ from motiongym.envs.sweeper.params import SweeperParams
 FORWARD, LEFT, RIGHT = 0, 1, 2
 EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
 MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
-# rounds of mode changes one step may take (without noise 3 at most on the shipped maps,
-# under noise 15 where it settles; a loop that does not settle repeats itself)
-MAX_ROUNDS = 50
-# votes a cell of a particle's map holds at most (fastslam.py): EVIDENCE, as the one map's;
-# 1 (the latest window wins) and 100 measured worse (docs/experiments/Sweeper-v1.md)
-PARTICLE_VOTES = EVIDENCE
+MAX_ROUNDS = 50  # mode changes per step (settled within 15 where measured), then move on
+PARTICLE_VOTES = EVIDENCE  # per particle's map (fastslam.py); 1 and 100 measured worse
 
 
 def turn_towards(heading: int, target: int) -> int:
@@ -191,11 +187,9 @@ class PsaCwaPolicy(DriftActing, ScriptedPolicy):
             a = getattr(self, "_" + m.mode)(m, r, c, h)
             if a is not None:
                 return a
-        # The modes did not settle: under odometry error, a plan whose every way on bumped
-        # from here, replanned the same from a map that still holds it free. Move on in a
-        # heading that has not bumped from this cell (a new cell clears the bumps), else
-        # turn; when all four have bumped, the bumps were felt at other true positions
-        # (slips that left the estimated cell unchanged) and are forgotten.
+        # Not settled: every way on bumped from here and the map replans the same. Move on
+        # in a heading that has not bumped here, else turn; bumps in all four headings were
+        # felt at other true positions (slips the estimate missed) and are forgotten.
         m.path.clear()
         if len(m.blocked) == 4:
             m.blocked.clear()
