@@ -30,11 +30,9 @@ import numpy as np
 
 from motiongym.baselines.sweeper import psa
 from motiongym.baselines.sweeper.belief import OBSTACLE
-from motiongym.baselines.sweeper.steer import steer
+from motiongym.baselines.sweeper.steer import DIRECTION, steer
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.occupancy import DC, DR
-
-DIRECTION = {(0, 1): 0, (-1, 0): 1, (0, -1): 2, (1, 0): 3}  # cell step -> heading
 
 
 class DriftActing:

@@ -36,6 +36,7 @@ map; what differs:
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -49,19 +50,10 @@ class ParticleMaps(Localiser):
     """Particles with a map each (see the module docstring); the same arguments as
     :class:`~.localise.Localiser` and ``evidence``, the votes a cell holds at most."""
 
-    def __init__(
-        self,
-        w: int,
-        R: int,
-        heading_noise: float,
-        slip_noise: float,
-        n: int = 256,
-        seed: int = 0,
-        diffusion: float = 0.0,
-        evidence: int = 4,
-    ) -> None:
-        super().__init__(w, R, heading_noise, slip_noise, n, seed, diffusion)
+    def __init__(self, *args: Any, evidence: int = 4, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
         self.evidence = evidence
+        n = self.n
         self.origin = np.zeros(2, np.int64)  # map cell of the box's index (0, 0)
         self.votes = np.zeros((n, 0, 0), np.int8)  # (n, H, W) clipped votes
         self.seen = np.zeros((n, 0, 0), bool)  # (n, H, W) sensed at least once

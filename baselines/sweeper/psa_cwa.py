@@ -50,9 +50,10 @@ from gymnasium import spaces
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper import cwa, psa, quadtree
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
-from motiongym.baselines.sweeper.drift import DIRECTION, DriftActing
+from motiongym.baselines.sweeper.drift import DriftActing
 from motiongym.baselines.sweeper.fastslam import ParticleMaps
 from motiongym.baselines.sweeper.localise import Localiser
+from motiongym.baselines.sweeper.steer import DIRECTION
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.occupancy import DC, DR
 from motiongym.envs.sweeper.params import SweeperParams

@@ -21,7 +21,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Sequence
 
+from motiongym.envs.sweeper.occupancy import DC, DR
+
 FORWARD, LEFT, RIGHT = 0, 1, 2
+# cell step -> heading, the inverse of the world's (DR, DC)
+DIRECTION = {(int(DR[h]), int(DC[h])): h for h in range(4)}
 
 
 def _turns(h: int, g: int) -> int:
@@ -77,7 +81,7 @@ def steer(
         if best is None or key > best[0]:
             best = (key, g)
     if best is None:  # nothing predicted to stay on the path: the plain rule
-        g = {(0, 1): 0, (-1, 0): 1, (0, -1): 2, (1, 0): 3}.get((target[0] - r, target[1] - c), h)
+        g = DIRECTION.get((target[0] - r, target[1] - c), h)
         if g in blocked:
             return None
     else:

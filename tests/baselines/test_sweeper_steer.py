@@ -9,7 +9,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from motiongym.baselines.sweeper.steer import FORWARD, steer
+from motiongym.baselines.sweeper.steer import DIRECTION, FORWARD, steer
 
 ENV_ID = "motiongym/Sweeper-v1"
 
@@ -40,7 +40,7 @@ def _drive(error: float, target_step: tuple[int, int], steering: bool) -> tuple[
                 lambda q: bool(reach[q]),
             )
         else:  # the plain rule: face the target's direction, then forward
-            want = {(0, 1): 0, (-1, 0): 1, (0, -1): 2, (1, 0): 3}[target_step]
+            want = DIRECTION[target_step]
             action = FORWARD if s.heading == want else (1 if (want - s.heading) % 4 == 1 else 2)
         world.advance(action, rng)
         if action == FORWARD:
