@@ -131,6 +131,7 @@ class PsaCwaPolicy(DriftActing, ScriptedPolicy):
     particle_maps = True  # localising: a map per particle (fastslam.py); False: one map
     map_votes = PARTICLE_VOTES  # with particle_maps: votes a cell holds at most
     diffuse = True  # localising: heading-error diffusion on moves (localise.py)
+    skip_ahead = True  # a move onto a later cell of the plan skips to it, not replans
 
     def __init__(self, observation_space, action_space, env_kwargs=None) -> None:
         super().__init__(observation_space, action_space, env_kwargs)
@@ -198,7 +199,7 @@ class PsaCwaPolicy(DriftActing, ScriptedPolicy):
 
     def _follow(self, m: Memory, r: int, c: int, h: int) -> int | None:
         """Execute the planned path of configurations (turn towards, then forward)."""
-        if (r, c) in list(m.path)[1:3]:  # a diagonal move (under odometry error) skipped one
+        if self.skip_ahead and (r, c) in list(m.path)[1:3]:  # a diagonal move skipped one
             while m.path[0] != (r, c):
                 m.path.popleft()
         while m.path and m.path[0] == (r, c):
