@@ -190,7 +190,7 @@ class Localiser:
         at = (np.rint(self.y) == self.cell[0]) & (np.rint(self.x) == self.cell[1])
         wt = self.wt * at if at.any() else self.wt
         if wt.sum() <= 0:  # every weight in the cell underflowed: its particles alike
-            wt = at.astype(float) if at.any() else np.ones(self.n)
+            wt = at.astype(float)  # (at.any() here: self.wt alone sums to 1)
         e = float(np.average(self.e, weights=self.wt))
         return float(np.average(self.y, weights=wt)), float(np.average(self.x, weights=wt)), e
 

@@ -34,8 +34,10 @@ import numpy as np
 
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper.belief import OBSTACLE, RobotMap
-from motiongym.baselines.sweeper.psa_cwa import FORWARD, LEFT, robot_geometry, turn_towards
+from motiongym.baselines.sweeper.psa_cwa import robot_geometry
+from motiongym.baselines.sweeper.steer import turn_towards
 from motiongym.envs.sweeper.occupancy import DC, DR, bfs_distance, box_sum, config_free
+from motiongym.envs.sweeper.world import FORWARD, LEFT
 
 
 class NearestUnsweptPolicy(ScriptedPolicy):

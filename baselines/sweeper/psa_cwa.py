@@ -53,21 +53,16 @@ from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, RobotMap
 from motiongym.baselines.sweeper.drift import DriftActing
 from motiongym.baselines.sweeper.fastslam import ParticleMaps
 from motiongym.baselines.sweeper.localise import Localiser
-from motiongym.baselines.sweeper.steer import DIRECTION
+from motiongym.baselines.sweeper.steer import DIRECTION, turn_towards
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.occupancy import DC, DR
 from motiongym.envs.sweeper.params import SweeperParams
+from motiongym.envs.sweeper.world import FORWARD, LEFT
 
-FORWARD, LEFT, RIGHT = 0, 1, 2
 EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
 MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
 MAX_ROUNDS = 50  # mode changes per step (settled within 15 where measured), then move on
 PARTICLE_VOTES = EVIDENCE  # per particle's map (fastslam.py); 1 and 100 measured worse
-
-
-def turn_towards(heading: int, target: int) -> int:
-    """The turn action that brings ``heading`` closer to ``target`` (left on a reversal)."""
-    return RIGHT if (target - heading) % 4 == 3 else LEFT
 
 
 def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:

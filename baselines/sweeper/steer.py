@@ -22,10 +22,15 @@ import math
 from collections.abc import Callable, Collection, Sequence
 
 from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.world import FORWARD, LEFT, RIGHT
 
-FORWARD, LEFT, RIGHT = 0, 1, 2
 # cell step -> heading, the inverse of the world's (DR, DC)
 DIRECTION = {(int(DR[h]), int(DC[h])): h for h in range(4)}
+
+
+def turn_towards(heading: int, target: int) -> int:
+    """The turn action that brings ``heading`` closer to ``target`` (left on a reversal)."""
+    return RIGHT if (target - heading) % 4 == 3 else LEFT
 
 
 def _turns(h: int, g: int) -> int:
@@ -86,6 +91,4 @@ def steer(
             return None
     else:
         g = best[1]
-    if g == h:
-        return FORWARD
-    return RIGHT if (g - h) % 4 == 3 else LEFT
+    return FORWARD if g == h else turn_towards(h, g)

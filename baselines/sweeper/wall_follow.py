@@ -37,8 +37,9 @@ import numpy as np
 
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.baselines.sweeper.belief import OBSTACLE, RobotMap
-from motiongym.baselines.sweeper.psa_cwa import FORWARD, LEFT, RIGHT, robot_geometry
+from motiongym.baselines.sweeper.psa_cwa import robot_geometry
 from motiongym.envs.sweeper.occupancy import DC, DR
+from motiongym.envs.sweeper.world import FORWARD, LEFT, RIGHT
 
 
 @dataclass

@@ -297,3 +297,19 @@ def test_skipping_to_a_later_cell_of_the_plan_earns_its_place() -> None:
         ours = coverage_at_done(PsaCwaPolicy, seed, grid=grid(), **NOISE)[0]
         theirs = coverage_at_done(NoSkip, seed, grid=grid(), **NOISE)[0]
         assert ours > 0.97 and ours > theirs + 0.1
+
+
+def test_the_continuous_pose_falls_back_to_the_cells_particles_when_their_weights_underflow():
+    """Particles in the estimated cell whose weights have all underflowed to 0 (the rest
+    hold the mass): the pose is their plain mean, not a division by zero; with weight in
+    the cell, the weighted mean of the cell's particles only; the heading error is the
+    weighted mean of all particles."""
+    loc = Localiser(3, 3, heading_noise=0.0, slip_noise=0.0, n=4)
+    loc.y = np.array([5.2, 4.8, 9.0, 9.0])
+    loc.x = np.array([7.0, 7.4, 2.0, 2.0])
+    loc.e = np.array([0.0, 0.0, 0.1, 0.3])
+    loc.cell = (5, 7)
+    loc.wt = np.array([0.0, 0.0, 0.5, 0.5])
+    assert np.allclose(loc.continuous(), (5.0, 7.2, 0.2))
+    loc.wt = np.array([0.3, 0.1, 0.3, 0.3])
+    assert np.allclose(loc.continuous(), (5.1, 7.1, 0.12))

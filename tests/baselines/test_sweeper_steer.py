@@ -9,7 +9,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from motiongym.baselines.sweeper.steer import DIRECTION, FORWARD, steer
+from motiongym.baselines.sweeper.steer import DIRECTION, steer
+from motiongym.envs.sweeper.world import FORWARD
 
 ENV_ID = "motiongym/Sweeper-v1"
 
