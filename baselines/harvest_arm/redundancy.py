@@ -25,6 +25,13 @@ reference velocity and ``k_i > 0`` its weight. This is the exact solution of
   the rate that reaches the limit and the rest re-solved without it; finally
   all rates are scaled by one factor so that none exceeds its speed limit
   (direction kept).
+* :func:`relaxed_rates` (not the paper's; the policies' ``critical_clearance``
+  option): the same cost without the constraint, the gripper one more
+  weighted point. Where a link is about to touch an obstacle, the null space
+  of ``Jn`` may hold no motion that takes it away (on HarvestArm-v0 scenes
+  where the field's teacher collides, the link point's clearance rate over
+  the null space is a tenth of its rate over all joint motions); dropping the
+  constraint lets the avoidance term move the gripper off its path.
 """
 
 from __future__ import annotations
@@ -100,4 +107,29 @@ def limited_rates(
         held[over] = np.clip(scaled[over], low[over], high[over])
         free &= ~over
     rates = np.clip(rates, low, high)
+    return rates * min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))
+
+
+def relaxed_rates(
+    jacs: np.ndarray,
+    refs: np.ndarray,
+    weights: np.ndarray,
+    q: np.ndarray,
+    limits: np.ndarray,
+    speeds: np.ndarray,
+    dt: float,
+    reg: float = 1e-9,
+) -> np.ndarray:
+    """``argmin sum_i k_i |Ji theta_dot - X_i_dot|^2`` (no gripper constraint): theta_dot (n,).
+
+    ``jacs`` (M, dim, n), ``refs`` (M, dim), ``weights`` (M,) as in
+    :func:`weighted_rates`, the gripper among them; ``reg`` as there. The
+    rates are clipped to those that reach a joint limit within ``dt`` and then
+    scaled by one factor to the speed limits.
+    """
+    n = jacs.shape[2]
+    s1 = np.einsum("m,mdi,mdj->ij", weights, jacs, jacs)
+    s2 = np.einsum("m,mdi,md->i", weights, jacs, refs)
+    s1 = s1 + (reg * max(np.trace(s1) / n, 1e-12)) * np.eye(n)
+    rates = np.clip(np.linalg.solve(s1, s2), (-limits - q) / dt, (limits - q) / dt)
     return rates * min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))
