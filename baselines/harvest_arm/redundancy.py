@@ -39,6 +39,21 @@ from __future__ import annotations
 import numpy as np
 
 
+def _normal_equations(
+    jacs: np.ndarray, refs: np.ndarray, weights: np.ndarray, reg: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``S1`` (n, n) with its ``reg * trace(S1) / n`` diagonal, and ``S2`` (n,)."""
+    n = jacs.shape[2]
+    s1 = 2.0 * np.einsum("m,mdi,mdj->ij", weights, jacs, jacs)
+    s2 = 2.0 * np.einsum("m,mdi,md->i", weights, jacs, refs)
+    return s1 + (reg * max(np.trace(s1) / n, 1e-12)) * np.eye(n), s2
+
+
+def _within_speeds(rates: np.ndarray, speeds: np.ndarray) -> np.ndarray:
+    """``rates`` scaled by one factor so that none exceeds its speed limit."""
+    return rates * min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))
+
+
 def weighted_rates(
     jn: np.ndarray,
     x_dot: np.ndarray,
@@ -55,10 +70,7 @@ def weighted_rates(
         jacs: joint-point Jacobians (M, dim, n); refs: their reference
             velocities (M, dim); weights: ``k_i`` (M,).
     """
-    n = jn.shape[1]
-    s1 = 2.0 * np.einsum("m,mdi,mdj->ij", weights, jacs, jacs)  # (n, n)
-    s2 = 2.0 * np.einsum("m,mdi,md->i", weights, jacs, refs)  # (n,)
-    s1 = s1 + (reg * max(np.trace(s1) / n, 1e-12)) * np.eye(n)
+    s1, s2 = _normal_equations(jacs, refs, weights, reg)
     a_jt = np.linalg.solve(s1, jn.T)  # S1^-1 Jn^T (n, dim)
     a_s2 = np.linalg.solve(s1, s2)  # S1^-1 S2 (n,)
     m = jn @ a_jt  # (dim, dim)
@@ -99,15 +111,13 @@ def limited_rates(
         sol = weighted_rates(jn[:, free], x_rest, jacs[:, :, free], ref_rest, weights, reg)
         rates = held.copy()
         rates[free] = sol
-        scale = min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))
-        scaled = rates * scale
+        scaled = _within_speeds(rates, speeds)
         over = free & ((scaled < low) | (scaled > high))
         if not over.any():
             return scaled
         held[over] = np.clip(scaled[over], low[over], high[over])
         free &= ~over
-    rates = np.clip(rates, low, high)
-    return rates * min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))
+    return _within_speeds(np.clip(rates, low, high), speeds)
 
 
 def relaxed_rates(
@@ -127,9 +137,6 @@ def relaxed_rates(
     rates are clipped to those that reach a joint limit within ``dt`` and then
     scaled by one factor to the speed limits.
     """
-    n = jacs.shape[2]
-    s1 = np.einsum("m,mdi,mdj->ij", weights, jacs, jacs)
-    s2 = np.einsum("m,mdi,md->i", weights, jacs, refs)
-    s1 = s1 + (reg * max(np.trace(s1) / n, 1e-12)) * np.eye(n)
+    s1, s2 = _normal_equations(jacs, refs, weights, reg)
     rates = np.clip(np.linalg.solve(s1, s2), (-limits - q) / dt, (limits - q) / dt)
-    return rates * min(1.0, float(np.min(speeds / np.maximum(np.abs(rates), 1e-12))))
+    return _within_speeds(rates, speeds)
