@@ -166,23 +166,35 @@ def _replace_sections(generated: str, sections: dict[str, str]) -> str:
     return generated
 
 
-def write_benchmarks(
-    path: Path, n_episodes: int = DEFAULT_EPISODES, ids: list[str] | None = None
-) -> Path:
-    """Regenerate the tables and figures of ``path`` (``BENCHMARKS.md``); with ``ids``,
-    only those IDs' sections, the others kept as they were."""
-    root = path.parent
-    figures = root / "docs" / "benchmarks"
+def _split(path: Path) -> tuple[str, str, str]:
+    """``path``'s text as (before :data:`BEGIN`, between the markers, after :data:`END`);
+    markers are added to a file without them, a missing file is a stub."""
     text = path.read_text() if path.is_file() else f"# Benchmarks\n\n{BEGIN}\n{END}\n"
     if BEGIN not in text or END not in text:
         text = f"{text.rstrip()}\n\n{BEGIN}\n{END}\n"
     head, rest = text.split(BEGIN, 1)
     generated, tail = rest.split(END, 1)
+    return head, generated, tail
+
+
+def write_benchmarks(
+    path: Path, n_episodes: int = DEFAULT_EPISODES, ids: list[str] | None = None
+) -> Path:
+    """Regenerate the tables and figures of ``path`` (``BENCHMARKS.md``); with ``ids``,
+    only those IDs' sections, the others kept as they were.
+
+    The file is read again after the evaluations (minutes to hours), just before it is
+    written, so that what was edited outside the generated part meanwhile is kept.
+    """
+    root = path.parent
+    figures = root / "docs" / "benchmarks"
     if ids is not None:
         unknown = [env_id for env_id in ids if env_id not in ENV_IDS]
         if unknown:
             raise ValueError(f"ids: {unknown} are not registered IDs ({', '.join(ENV_IDS)})")
+        _replace_sections(_split(path)[1], {i: "" for i in ids})  # refuse before evaluating
         sections = {i: benchmark_section(i, n_episodes, figures, root) for i in ids}
+        head, generated, tail = _split(path)
         path.write_text(head + BEGIN + _replace_sections(generated, sections) + END + tail)
         return path
     command = f"motiongym benchmarks --episodes {n_episodes}"
@@ -195,5 +207,6 @@ def write_benchmarks(
     ]
     body += [benchmark_section(env_id, n_episodes, figures, root) for env_id in ENV_IDS]
     body.append(END)
+    head, _, tail = _split(path)
     path.write_text(head + "\n".join(body) + tail)
     return path

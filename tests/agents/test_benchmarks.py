@@ -58,3 +58,24 @@ def test_benchmarks_ids_rewrites_only_those_sections(one_shipped_id, tmp_path):
         benchmarks.write_benchmarks(path, n_episodes=2, ids=[ENV_ID])
     with pytest.raises(ValueError, match=r"\['Nope-v0'\] are not registered"):
         benchmarks.write_benchmarks(path, n_episodes=2, ids=["Nope-v0"])
+
+
+@pytest.mark.parametrize("ids", [None, [ENV_ID]])
+def test_benchmarks_keeps_what_was_edited_while_it_evaluated(
+    one_shipped_id, monkeypatch, tmp_path, ids
+):
+    """The file is read again just before it is written: a reading edited during the
+    evaluations (they take minutes to hours) is not written over by the copy read at the
+    start."""
+    path = tmp_path / "BENCHMARKS.md"
+    path.write_text(f"reading\n\n{benchmarks.BEGIN}\n### {ENV_ID}\n\nstale\n{benchmarks.END}\n")
+    section = benchmarks.benchmark_section
+
+    def edit_meanwhile(*args):
+        path.write_text(path.read_text().replace("reading", "reading, edited meanwhile"))
+        return section(*args)
+
+    monkeypatch.setattr(benchmarks, "benchmark_section", edit_meanwhile)
+    benchmarks.write_benchmarks(path, n_episodes=2, ids=ids)
+    text = path.read_text()
+    assert text.startswith("reading, edited meanwhile\n") and "stale" not in text
