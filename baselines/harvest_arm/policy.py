@@ -59,7 +59,9 @@ fruit direction is below this (held-out HarvestArmPlanar-v0: 97 % success, 86 % 
 docs/experiments/HarvestArmPlanar-v0.md)."""
 RELAXED_GRIPPER_WEIGHT = 10.0
 """``critical_clearance``: the gripper's ``k_i`` in the unconstrained eq. 1 (the joint
-points' are 1, a link's control point's ``1 + |w_ob|``, 9 at 5 cm, 120 at 2 cm)."""
+points' are 1, a link's control point's ``1 + |w_ob|``, 9 at 5 cm, 120 at 2 cm). It
+matters little: HarvestArm-v0, ``markov``, 0.03 m, development seeds 5000-5999: 96.9 /
+97.1 / 97.7 % success with 3 / 10 / 30, no collision with any."""
 
 
 class _ArmPolicy(ScriptedPolicy):
@@ -112,7 +114,8 @@ class PotentialFieldPolicy(_ArmPolicy):
     minimum) the vortex field acts instead.
 
     ``critical_clearance`` (m, off by default, not the paper's): while a
-    link's control point is closer than this to an obstacle, eq. 1 is solved
+    link's control point (they exist within the avoidance row's ``rho0``,
+    0.2 m) is closer than this to an obstacle, eq. 1 is solved
     without its gripper constraint (:func:`.redundancy.relaxed_rates`, the
     gripper weighted :data:`RELAXED_GRIPPER_WEIGHT`), so the link's avoidance
     can take the gripper off its path; the paper's constraint leaves it only
