@@ -29,8 +29,9 @@ from motiongym.baselines.dual_arm import exact_delay, schedules
 from motiongym.baselines.dual_arm.boundary_following import boundary_following
 from motiongym.baselines.dual_arm.bracket import exact_delay_search
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
+from motiongym.baselines.dual_arm.lag_map import LagMap
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.core import params_from_kwargs
+from motiongym.envs.core import check_bool, params_from_kwargs
 from motiongym.envs.dual_arm.params import DualArmParams
 from motiongym.envs.dual_arm.task import DT
 from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
@@ -147,7 +148,38 @@ class BoundaryFollowingPolicy(SchedulePolicy):
     (:func:`.bracket.exact_delay_search`): the minimum pure delay on v1's
     check; where none exists (``reason`` in the memory: e.g. the arms collide
     at rest) robot 2 starts when robot 1 ends, reported as a fallback.
+
+    ``replan`` (not the paper's; for a DAgger teacher): instead of replaying
+    the planned schedule by the clock, every step asks of the current state
+    (robot 1's and robot 2's progress in the observation) whether "go now at
+    full speed" is collision free to the end on the environment's own check
+    (:class:`.lag_map.LagMap`, v0's or v1's), and advances robot 2 only then.
+    From its own start that is the minimum pure delay on that check (on v0,
+    the exhaustive one, not the paper's map's); from a state a learner
+    reached (robot 2 started early, or stopped part-way) it answers for that
+    state, where a replayed schedule would only read the clock.
     """
+
+    def __init__(self, observation_space, action_space, env_kwargs=None, replan=False, **kwargs):
+        super().__init__(observation_space, action_space, env_kwargs, **kwargs)
+        self.replan = check_bool("replan", replan)
+
+    def new_memory(self) -> dict[str, Any]:
+        return {**super().new_memory(), "lag_map": None}
+
+    def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
+        if not self.replan:
+            return super().act(observation, memory)
+        obs = np.asarray(observation, dtype=float)
+        if memory["lag_map"] is None:
+            traj1, traj2 = tasks_from_observation(obs)
+            memory["lag_map"] = LagMap(traj1, traj2, self.safety_margin, self.swept)
+        lag_map = memory["lag_map"]
+        x, p2 = lag_map.state(obs)
+        a2 = 1.0 if lag_map.clear_now(x, p2) else 0.0
+        if self.action_space.shape == (2,):
+            return np.array([1.0, a2], dtype=np.float32)
+        return np.array([a2], dtype=np.float32)
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
         if self.swept:
