@@ -78,7 +78,7 @@ SEEDS ?= 0 1 2
 # Agents from demonstrations (DAgger, configs/<ID>-dagger.yml), shipped as sac-dagger on 100
 # held-out episodes, the harvest arms' on 1000 (their first 100 are easier than the next 900,
 # for the potential field and the learner alike: docs/experiments/HarvestArm-v0.md).
-DAGGER_IDS ?= ExcavatorReach-v0 ExcavatorReach-v1 DualArmCell-v1 HarvestArm-v0 HarvestArmPlanar-v0
+DAGGER_IDS ?= ExcavatorReach-v0 ExcavatorReach-v1 DualArmCell-v0 DualArmCell-v1 HarvestArm-v0 HarvestArmPlanar-v0
 # The same with a discrete, masked learner (maskableppo-dagger), shipped on the 20 held-out
 # episodes of the ID's other shipped model (BENCHMARKS compares them on the same episodes).
 MASKED_DAGGER_IDS ?= Sweeper-v1

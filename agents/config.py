@@ -63,12 +63,16 @@ dagger_episodes episodes rolled out per DAgger iteration             50
 memory         a learner-side memory added to the observation:         null
                ``sweeper_map`` (:mod:`motiongym.agents.map_memory`:
                the robot's own map, built from its observations, as
-               robot-centred crops under the key ``memory``); the
+               robot-centred crops under the key ``memory``) or
+               ``dual_arm_map`` (:mod:`motiongym.agents.dual_arm_map`:
+               robot 2's waits and their collisions, from the tasks,
+               in place of the observation); the
                training envs are wrapped with it and a loaded model
                builds it from the observations it is given.
                ``vec_env`` dummy or subproc; not with ``residual``
 memory_kwargs  the memory's settings (mapping): ``levels``, ``crop``,  {}
-               ``factor``
+               ``factor`` (sweeper_map); ``lags``, ``bin_steps``,
+               ``bins`` (dual_arm_map)
 deterministic  how the model acts in evaluations (the training        true
                callback's, ``evaluate``, ``compare``, ``ship``): its
                most likely action (true) or one sampled from its
@@ -328,7 +332,7 @@ def _check_memory(config: dict[str, Any]) -> None:
             raise ArgumentError("memory_kwargs needs memory")
         return
     check_choice("memory", name, sorted(MEMORIES))
-    check_memory_kwargs(config["memory_kwargs"])
+    check_memory_kwargs(config["memory_kwargs"], name)
     if config["vec_env"] not in ("dummy", "subproc"):
         raise ArgumentError(f"memory needs vec_env dummy or subproc, got {config['vec_env']!r}")
     if config["residual"] is not None:

@@ -23,7 +23,10 @@ plan is made from the same first observation as on its own, and its
 progress (waypoint index, nearest path point, schedule step) is read from
 the learner's states, so each label is "what the teacher does from here,
 given the plan it made at the start". The learner never sees the memory:
-it acts from the observation alone.
+it acts from the observation alone. Where the environment is a learner-side
+memory wrapper (:class:`motiongym.agents.map_memory.MemoryWrapper`), the
+teacher reads the environment's own observation (``raw_observation``) and the
+learner the wrapper's.
 
 Episodes of iteration ``i`` are seeded ``seed + i * episodes + j`` (default
 :data:`~motiongym.agents.dataset.DATASET_SEED`, far from the evaluation
@@ -73,7 +76,8 @@ def _rollout(
     observations, labels, guesses = [], [], []
     start, done = True, False
     while not done:
-        label, _ = teacher.predict(observation, episode_start=np.array([start]))
+        seen = getattr(env, "raw_observation", observation)  # a memory wrapper's input
+        label, _ = teacher.predict(seen, episode_start=np.array([start]))
         start = False
         action = label
         if learner is not None:

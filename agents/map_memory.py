@@ -1,4 +1,6 @@
-"""A learner-side spatial memory for the sweeper: its own map, shown as robot-centred crops.
+"""Learner-side memories (``memory:`` in a config): the sweeper's own map, shown as
+robot-centred crops (below), and the dual-arm cell's lag map
+(:mod:`motiongym.agents.dual_arm_map`, ``dual_arm_map``).
 
 The sweeper's observation (``SweeperEnv``) holds the believed ``pose`` and
 the ``sensed`` / ``known`` / ``swept`` windows every step, and only coarse
@@ -59,6 +61,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from motiongym.agents.dual_arm_map import DualArmMapMemory, check_dual_arm_map_kwargs
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, UNKNOWN, RobotMap
 from motiongym.envs.core import ArgumentError, check_int
 from motiongym.envs.sweeper.occupancy import config_free, footprint_union
@@ -67,7 +70,7 @@ MEMORY_KEY = "memory"
 CHANNELS = ("todo", "obstacle", "unknown")  # per level, in this order
 
 
-def check_memory_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
+def check_sweeper_map_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
     """The pyramid's settings (``levels``, ``crop``, ``factor``) checked, defaults
     filled in; an unknown key or a bad value is an ``ArgumentError``."""
     settings = {"levels": 3, "crop": 11, "factor": 3}
@@ -104,11 +107,11 @@ class SweeperMapMemory:
     Args:
         robot_width: ``w`` (cells).
         sensor_range: ``R`` (cells beyond the footprint; the windows are ``w + 2R``).
-        levels, crop, factor: the pyramid (:func:`check_memory_kwargs`).
+        levels, crop, factor: the pyramid (:func:`check_sweeper_map_kwargs`).
     """
 
     def __init__(self, robot_width: int, sensor_range: int, **kwargs: Any) -> None:
-        settings = check_memory_kwargs(kwargs)
+        settings = check_sweeper_map_kwargs(kwargs)
         self.w, self.R = int(robot_width), int(sensor_range)
         self.levels, self.crop = settings["levels"], settings["crop"]
         self.factor = settings["factor"]
@@ -172,42 +175,64 @@ class SweeperMapMemory:
         return np.ascontiguousarray(np.rot90(pyramid, (1 - h) % 4, axes=(1, 2)))
 
 
-class MapMemoryWrapper(gym.ObservationWrapper):
-    """A sweeper environment whose observations carry the map memory (reset with it)."""
+class MemoryWrapper(gym.ObservationWrapper):
+    """An environment whose observations carry a learner-side memory (reset with it);
+    subclasses name the memory class (``for_env``, ``space``, ``reset``, ``observe``).
+    ``raw_observation`` is the environment's own last observation (what a scripted
+    teacher reads)."""
+
+    memory_class: Any = None
 
     def __init__(self, env: gym.Env, **memory_kwargs: Any) -> None:
         super().__init__(env)
-        self.memory = SweeperMapMemory.for_env(env, **memory_kwargs)
+        self.memory = self.memory_class.for_env(env, **memory_kwargs)
         self.observation_space = self.memory.space(env.observation_space)
 
-    def reset(self, **kwargs: Any) -> tuple[dict, dict]:
+    def reset(self, **kwargs: Any) -> tuple[Any, dict]:
         self.memory.reset()
         return super().reset(**kwargs)
 
-    def observation(self, observation: dict[str, Any]) -> dict[str, Any]:
+    def observation(self, observation: Any) -> Any:
+        self.raw_observation = observation  # the environment's own, for a DAgger teacher
         return self.memory.observe(observation)
 
 
+class MapMemoryWrapper(MemoryWrapper):
+    """A sweeper environment whose observations carry the map memory (reset with it)."""
+
+    memory_class = SweeperMapMemory
+
+
+class DualArmMapWrapper(MemoryWrapper):
+    """A dual-arm environment seen through the lag map (:mod:`motiongym.agents.dual_arm_map`)."""
+
+    memory_class = DualArmMapMemory
+
+
 class MapMemoryPredictor:
-    """A model trained on :class:`MapMemoryWrapper`'s observations, acting in the bare
+    """A model trained on a :class:`MemoryWrapper`'s observations, acting in the bare
     environment: it builds the same memory from the observations it is given.
 
     One memory per sub-environment (observations may come batched, with a
     leading axis); a sub-environment's memory is emptied where ``episode_start``
     is true (without ``episode_start`` it persists from call to call, as a
     scripted policy's does). Keywords after ``deterministic`` (the action
-    masks) go to the model unchanged.
+    masks) go to the model unchanged. ``memory``: a name of :data:`MEMORIES`.
     """
 
-    def __init__(self, model: Any, env: gym.Env, **memory_kwargs: Any) -> None:
+    def __init__(self, model: Any, env: gym.Env, memory: str = "sweeper_map", **memory_kwargs):
         self.model = model
-        self.make = lambda: SweeperMapMemory.for_env(env, **memory_kwargs)
-        self.window = env.observation_space["sensed"].shape
-        self.memories: list[SweeperMapMemory] = []
+        memory_class = MEMORIES[memory].memory_class
+        self.make = lambda: memory_class.for_env(env, **memory_kwargs)
+        space = env.observation_space
+        self.key = next(iter(space.spaces)) if isinstance(space, spaces.Dict) else None
+        self.rank = len((space[self.key] if self.key else space).shape)
+        self.memories: list[Any] = []
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True, **kwargs):
-        batched = np.ndim(observation["sensed"]) > len(self.window)
-        n = len(observation["sensed"]) if batched else 1
+        first = observation[self.key] if self.key else observation
+        batched = np.ndim(first) > self.rank
+        n = len(first) if batched else 1
         if len(self.memories) != n:
             self.memories = [self.make() for _ in range(n)]
         starts = np.zeros(n, bool)
@@ -217,14 +242,34 @@ class MapMemoryPredictor:
         for i, memory in enumerate(self.memories):
             if starts[i]:
                 memory.reset()
-            one = {k: v[i] for k, v in observation.items()} if batched else observation
+            if not batched:
+                one = observation
+            elif self.key:
+                one = {k: v[i] for k, v in observation.items()}
+            else:
+                one = observation[i]
             seen.append(memory.observe(one))
-        if batched:
+        if not batched:
+            observation = seen[0]
+        elif self.key:
             observation = {k: np.stack([s[k] for s in seen]) for k in seen[0]}
         else:
-            observation = seen[0]
+            observation = np.stack(seen)
         return self.model.predict(observation, state, episode_start, deterministic, **kwargs)
 
 
 # Names a config may give ``memory`` -> the wrapper that adds it in training.
-MEMORIES: dict[str, type[gym.ObservationWrapper]] = {"sweeper_map": MapMemoryWrapper}
+MEMORIES: dict[str, type[MemoryWrapper]] = {
+    "sweeper_map": MapMemoryWrapper,
+    "dual_arm_map": DualArmMapWrapper,
+}
+# Each memory's keyword check (defaults filled in).
+MEMORY_KWARGS_CHECKS = {
+    "sweeper_map": check_sweeper_map_kwargs,
+    "dual_arm_map": check_dual_arm_map_kwargs,
+}
+
+
+def check_memory_kwargs(kwargs: dict[str, Any], memory: str = "sweeper_map") -> dict[str, Any]:
+    """``memory``'s settings checked, defaults filled in (an ``ArgumentError`` if bad)."""
+    return MEMORY_KWARGS_CHECKS[memory](kwargs)

@@ -283,7 +283,7 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
         model = load_archive(file, seen.observation_space, env.action_space, what, kwargs)
         predictor = _normalized(model, file, DummyVecEnv([lambda: seen]))
         if memory:
-            predictor = MapMemoryPredictor(predictor, env, **config["memory_kwargs"])
+            predictor = MapMemoryPredictor(predictor, env, memory, **config["memory_kwargs"])
         if isinstance(model, MaskablePPO):
             predictor = MaskedModel(predictor, env)
     beside = (file.parent / NORMALIZATION_FILE, file.parent / PICKLED_NORMALIZATION)

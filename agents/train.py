@@ -191,16 +191,16 @@ def _imitate(env_id: str, config: dict[str, Any], model, venv, seed: int, run_di
     from motiongym.agents.dagger import dagger, history_json
     from motiongym.baselines import make_policy
 
-    env = gym.make(env_id, **config["env_kwargs"])
-    if config["memory"]:  # the learner sees the memory; the teacher ignores the entry
-        env = MEMORIES[config["memory"]](env, **config["memory_kwargs"])
+    env = bare = gym.make(env_id, **config["env_kwargs"])
+    if config["memory"]:  # the learner sees the memory; the teacher the env's observation
+        env = MEMORIES[config["memory"]](bare, **config["memory_kwargs"])
     try:
         teacher = make_policy(
             env_id,
             config["imitate"],
-            env.observation_space,
-            env.action_space,
-            env.spec.kwargs,
+            bare.observation_space,
+            bare.action_space,
+            bare.spec.kwargs,
             **config["imitate_kwargs"],
         )
     except (TypeError, ValueError) as error:  # a keyword the teacher lacks, or a bad value
