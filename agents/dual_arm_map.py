@@ -14,7 +14,12 @@ to the learner: the map says which waits are free, not which to take.
 
 Observation seen by the learner (Box, float32): robot 1's and robot 2's
 progress (the environment's ``progress``, 2 entries), then the lag map row
-by row (``len(lags) * bins`` entries, 0 or 1). The rest of the environment's
+by row (``len(lags) * (bins + 1)`` entries: each row's bins, 0 or 1, then
+its first colliding step's distance as a fraction of the horizon, 1 for
+none; ``first_hit: false`` leaves it out). The distance is the row's pooled
+summary: without it a learner has to find one blocked bin among 64
+(docs/experiments/DualArmCell-v0.md measures the difference).
+The rest of the environment's
 observation is dropped: the tasks are in the map, and a network fed the 54
 raw task numbers memorises its training scenes (the measure cited above).
 
@@ -31,16 +36,22 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.baselines.dual_arm.lag_map import LagMap
-from motiongym.envs.core import ArgumentError, check_int
+from motiongym.envs.core import ArgumentError, check_bool, check_int
 from motiongym.envs.dual_arm.world import OBS, OBS_SIZE, tasks_from_observation
 
 TASKS = slice(OBS["task1"].start, OBS["task2"].stop)
 
 
 def check_dual_arm_map_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
-    """``lags`` (distinct steps, 0 first), ``bin_steps`` and ``bins`` checked, defaults
+    """``lags`` (distinct steps, 0 first), ``bin_steps``, ``bins`` and ``first_hit`` (each
+    row's first-collision entry shown; False only for its ablation) checked, defaults
     filled in; an unknown key or a bad value is an ``ArgumentError``."""
-    settings: dict[str, Any] = {"lags": [0, 1, 2, 4, 8, 16, 32, 64], "bin_steps": 8, "bins": 64}
+    settings: dict[str, Any] = {
+        "lags": [0, 1, 2, 4, 8, 16, 32, 64],
+        "bin_steps": 8,
+        "bins": 64,
+        "first_hit": True,
+    }
     if not isinstance(kwargs, dict):
         raise ArgumentError(f"memory_kwargs must be a mapping, got {kwargs!r}")
     unknown = sorted(set(kwargs) - set(settings), key=str)
@@ -63,6 +74,7 @@ def check_dual_arm_map_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
         )
     check_int("memory_kwargs.bin_steps", settings["bin_steps"], 1, 100)
     check_int("memory_kwargs.bins", settings["bins"], 1, 1000)
+    check_bool("memory_kwargs.first_hit", settings["first_hit"])
     settings["lags"] = list(lags)
     return settings
 
@@ -80,8 +92,8 @@ class DualArmMapMemory:
         settings = check_dual_arm_map_kwargs(kwargs)
         self.margin, self.swept = float(margin), bool(swept)
         self.lags, self.bin_steps = settings["lags"], settings["bin_steps"]
-        self.bins = settings["bins"]
-        self.size = 2 + len(self.lags) * self.bins
+        self.bins, self.first_hit = settings["bins"], settings["first_hit"]
+        self.size = 2 + len(self.lags) * (self.bins + int(self.first_hit))
         self.tasks: np.ndarray | None = None
         self.map: LagMap | None = None
 
@@ -110,5 +122,7 @@ class DualArmMapMemory:
             self.map, self.tasks = LagMap(traj1, traj2, self.margin, self.swept), tasks
         x, p2 = self.map.state(obs)
         view = self.map.window(x, p2, self.lags, self.bin_steps, self.bins)
+        if not self.first_hit:
+            view = view[:, :-1]
         progress = obs[OBS["progress"]].astype(np.float32)
         return np.concatenate([progress, view.ravel()]).astype(np.float32)

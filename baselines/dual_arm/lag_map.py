@@ -107,10 +107,14 @@ class LagMap:
     def window(
         self, x: int, p2: float, lags: Sequence[int], bin_steps: int, bins: int
     ) -> np.ndarray:
-        """(len(lags), bins) float32: row ``j`` marks the bins of ``bin_steps`` steps in which
-        "wait ``lags[j]``, then go" collides, over the next ``bins * bin_steps`` steps."""
-        out = np.empty((len(lags), bins), dtype=np.float32)
+        """(len(lags), bins + 1) float32: row ``j`` marks the bins of ``bin_steps`` steps in
+        which "wait ``lags[j]``, then go" collides, over the next ``bins * bin_steps``
+        steps; its last entry is the first colliding step's distance as a fraction of
+        that horizon (1: none within it)."""
+        horizon = bins * bin_steps
+        out = np.empty((len(lags), bins + 1), dtype=np.float32)
         for j, lag in enumerate(lags):
-            hit = self.blocked(x, p2, int(lag), bins * bin_steps)
-            out[j] = hit.reshape(bins, bin_steps).any(axis=1)
+            hit = self.blocked(x, p2, int(lag), horizon)
+            out[j, :bins] = hit.reshape(bins, bin_steps).any(axis=1)
+            out[j, bins] = np.argmax(hit) / horizon if hit.any() else 1.0
         return out

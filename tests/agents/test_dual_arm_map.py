@@ -34,13 +34,15 @@ def test_the_view_shows_which_delays_the_environment_runs_clear():
     2 + bins) is all clear at step ``x`` exactly when the pure delay ``x`` runs without
     collision in the environment (checked at the first clear step and the one before)."""
     env = DualArmMapWrapper(gym.make(V1), lags=[0, 4], bin_steps=8, bins=64)
-    assert env.observation_space.shape == (2 + 2 * 64,)
+    assert env.observation_space.shape == (2 + 2 * 65,)
     obs, _ = env.reset(seed=100001)
     x = 0
     while obs[2 : 2 + 64].any():
-        assert set(np.unique(obs)) <= {0.0, 1.0} | set(obs[:2].tolist())
+        assert set(np.unique(obs[2:66])) <= {0.0, 1.0}
+        assert 0.0 <= obs[66] < 1.0  # a collision ahead on "go now"
         obs, *_ = env.step(np.array([1.0, 0.0], np.float32))
         x += 1
+    assert obs[66] == 1.0
     bare = gym.make(V1)
     assert _run_delay(bare, 100001, x)
     assert not _run_delay(bare, 100001, x - 1)
@@ -86,6 +88,9 @@ def test_settings_and_environment_are_checked():
             check_dual_arm_map_kwargs({"lags": lags})
     with pytest.raises(ArgumentError, match="memory_kwargs.bins"):
         check_dual_arm_map_kwargs({"bins": 0})
+    with pytest.raises(ArgumentError, match="memory_kwargs.first_hit"):
+        check_dual_arm_map_kwargs({"first_hit": "no"})
+    assert DualArmMapWrapper(gym.make(V1), first_hit=False).observation_space.shape == (514,)
     with pytest.raises(ValueError, match="needs a dual-arm environment"):
         DualArmMapWrapper(gym.make("CartPole-v1"))
 

@@ -45,15 +45,20 @@ def test_first_clear_go_is_the_environments_minimum_delay(env_id):
 
 def test_window_rows_are_the_further_waits():
     """Row ``j`` of the window is "wait lags[j], then go": at the start, row 0 of the window
-    at step ``x`` equals row ``w`` at step ``x - w`` (the same pure delay), bin by bin."""
+    at step ``x`` equals row ``w`` at step ``x - w`` (the same pure delay), bin by bin; each
+    row's last entry is its first colliding step over the horizon."""
     env = gym.make(V1)
     obs, _ = env.reset(seed=100003)
     lag_map = LagMap(*tasks_from_observation(obs), 0.0, True)
     lags = [0, 5, 12]
     later = lag_map.window(12, 0.0, [0], 1, 300)
     earlier = lag_map.window(0, 0.0, lags, 1, 312)
-    assert np.array_equal(earlier[2, 12:], later[0])
+    assert earlier.shape == (3, 313)
+    assert np.array_equal(earlier[2, 12:312], later[0, :300])
     assert earlier[2, :12].sum() == lag_map.table[:12, 0].sum()  # waiting at the start
+    for row in earlier:
+        hits = np.flatnonzero(row[:312])
+        assert row[312] == np.float32(hits[0] / 312 if len(hits) else 1.0)
 
 
 @pytest.mark.parametrize("seed", [100000, 100065])
