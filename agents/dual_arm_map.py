@@ -36,7 +36,7 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.baselines.dual_arm.lag_map import LagMap
-from motiongym.envs.core import ArgumentError, check_bool, check_int
+from motiongym.envs.core import ArgumentError, check_bool, check_int, check_keys
 from motiongym.envs.dual_arm.world import OBS, OBS_SIZE, tasks_from_observation
 
 TASKS = slice(OBS["task1"].start, OBS["task2"].stop)
@@ -52,14 +52,7 @@ def check_dual_arm_map_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
         "bins": 64,
         "first_hit": True,
     }
-    if not isinstance(kwargs, dict):
-        raise ArgumentError(f"memory_kwargs must be a mapping, got {kwargs!r}")
-    unknown = sorted(set(kwargs) - set(settings), key=str)
-    if unknown:
-        raise ArgumentError(
-            f"unknown memory_kwargs key {unknown[0]!r}; valid: {', '.join(settings)}"
-        )
-    settings.update(kwargs)
+    settings.update(check_keys("memory_kwargs", kwargs, settings))
     lags = settings["lags"]
     if (
         not isinstance(lags, (list, tuple))

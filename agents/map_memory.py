@@ -63,7 +63,7 @@ from gymnasium import spaces
 
 from motiongym.agents.dual_arm_map import DualArmMapMemory, check_dual_arm_map_kwargs
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE, UNKNOWN, RobotMap
-from motiongym.envs.core import ArgumentError, check_int
+from motiongym.envs.core import ArgumentError, check_int, check_keys
 from motiongym.envs.sweeper.occupancy import config_free, footprint_union
 
 MEMORY_KEY = "memory"
@@ -74,14 +74,7 @@ def check_sweeper_map_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
     """The pyramid's settings (``levels``, ``crop``, ``factor``) checked, defaults
     filled in; an unknown key or a bad value is an ``ArgumentError``."""
     settings = {"levels": 3, "crop": 11, "factor": 3}
-    if not isinstance(kwargs, dict):
-        raise ArgumentError(f"memory_kwargs must be a mapping, got {kwargs!r}")
-    unknown = sorted(set(kwargs) - set(settings), key=str)
-    if unknown:
-        raise ArgumentError(
-            f"unknown memory_kwargs key {unknown[0]!r}; valid: {', '.join(settings)}"
-        )
-    settings.update(kwargs)
+    settings.update(check_keys("memory_kwargs", kwargs, settings))
     check_int("memory_kwargs.levels", settings["levels"], 1, 4)
     check_int("memory_kwargs.crop", settings["crop"], 3, 31)
     check_int("memory_kwargs.factor", settings["factor"], 1, 9)

@@ -180,6 +180,19 @@ def check_render_mode(render_mode: Any, allowed: Sequence[str]) -> str | None:
     return mode
 
 
+def check_keys(name: str, value: Any, valid: Iterable[str]) -> dict[str, Any]:
+    """``value`` as a dict whose keys are all in ``valid`` (a settings mapping such as a
+    config's ``memory_kwargs``); anything but a mapping, or another key, is an
+    :class:`ArgumentError` naming ``name``."""
+    valid = list(valid)
+    if not isinstance(value, Mapping):
+        raise ArgumentError(f"{name} must be a mapping, got {value!r}")
+    unknown = sorted(set(value) - set(valid), key=str)
+    if unknown:
+        raise ArgumentError(f"unknown {name} key {unknown[0]!r}; valid: {', '.join(valid)}")
+    return dict(value)
+
+
 def check_options(
     options: Any, validators: Mapping[str, Callable[[str, Any], Any]]
 ) -> dict[str, Any]:

@@ -8,6 +8,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
+from dual_arm_runs import run_pure_delay
 from stable_baselines3 import SAC
 
 from motiongym.agents.dagger import dagger, on_policy_error
@@ -17,16 +18,6 @@ from motiongym.baselines import make_policy
 from motiongym.envs.core import ArgumentError
 
 V1 = "motiongym/DualArmCell-v1"
-
-
-def _run_delay(env: gym.Env, seed: int, delay: int) -> bool:
-    env.reset(seed=seed)
-    t, done = 0, False
-    while not done:
-        action = np.array([1.0, 1.0 if t >= delay else 0.0], np.float32)
-        _, _, terminated, truncated, info = env.step(action)
-        done, t = terminated or truncated, t + 1
-    return bool(info["is_success"])
 
 
 def test_the_view_shows_which_delays_the_environment_runs_clear():
@@ -44,8 +35,8 @@ def test_the_view_shows_which_delays_the_environment_runs_clear():
         x += 1
     assert obs[66] == 1.0
     bare = gym.make(V1)
-    assert _run_delay(bare, 100001, x)
-    assert not _run_delay(bare, 100001, x - 1)
+    assert run_pure_delay(bare, 100001, x)
+    assert not run_pure_delay(bare, 100001, x - 1)
 
 
 class _Echo:
@@ -81,6 +72,8 @@ def test_the_predictor_builds_what_the_wrapper_showed_in_training():
 
 def test_settings_and_environment_are_checked():
     assert check_dual_arm_map_kwargs({})["bins"] == 64
+    with pytest.raises(ArgumentError, match="memory_kwargs must be a mapping"):
+        check_dual_arm_map_kwargs([("bins", 8)])
     with pytest.raises(ArgumentError, match="unknown memory_kwargs key 'crop'"):
         check_dual_arm_map_kwargs({"crop": 3})
     for lags in ([4, 0], [0, 0], [], [0, -1], [0, 1.5], "0"):

@@ -6,23 +6,13 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+from dual_arm_runs import run_pure_delay
 
 from motiongym.baselines import make_policy
 from motiongym.baselines.dual_arm.lag_map import LagMap
 from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
 
 V0, V1 = "motiongym/DualArmCell-v0", "motiongym/DualArmCell-v1"
-
-
-def _run_delay(env: gym.Env, seed: int, delay: int) -> bool:
-    """Does the pure delay ``delay`` run to the end without collision in ``env``?"""
-    env.reset(seed=seed)
-    t, done = 0, False
-    while not done:
-        action = np.array([1.0, 1.0 if t >= delay else 0.0], np.float32)
-        _, _, terminated, truncated, info = env.step(action)
-        done, t = terminated or truncated, t + 1
-    return bool(info["is_success"])
 
 
 @pytest.mark.parametrize("env_id", [V0, V1])
@@ -39,8 +29,8 @@ def test_first_clear_go_is_the_environments_minimum_delay(env_id):
         )
         first = next(x for x in range(lag_map.n1 + 1) if lag_map.clear_now(x, 0.0))
         assert first > 0  # "colliding" pairs: starting together collides
-        assert _run_delay(env, seed, first), (env_id, seed, first)
-        assert not _run_delay(env, seed, first - 1), (env_id, seed, first)
+        assert run_pure_delay(env, seed, first), (env_id, seed, first)
+        assert not run_pure_delay(env, seed, first - 1), (env_id, seed, first)
 
 
 def test_window_rows_are_the_further_waits():
