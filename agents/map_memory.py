@@ -170,11 +170,13 @@ class SweeperMapMemory:
 
 class MemoryWrapper(gym.ObservationWrapper):
     """An environment whose observations carry a learner-side memory (reset with it);
-    subclasses name the memory class (``for_env``, ``space``, ``reset``, ``observe``).
+    subclasses name the memory class (``for_env``, ``space``, ``reset``, ``observe``) and
+    its settings' check (``check_kwargs``, defaults filled in).
     ``raw_observation`` is the environment's own last observation (what a scripted
     teacher reads)."""
 
     memory_class: Any = None
+    check_kwargs: Any = None
 
     def __init__(self, env: gym.Env, **memory_kwargs: Any) -> None:
         super().__init__(env)
@@ -194,12 +196,14 @@ class MapMemoryWrapper(MemoryWrapper):
     """A sweeper environment whose observations carry the map memory (reset with it)."""
 
     memory_class = SweeperMapMemory
+    check_kwargs = staticmethod(check_sweeper_map_kwargs)
 
 
 class DualArmMapWrapper(MemoryWrapper):
     """A dual-arm environment seen through the lag map (:mod:`motiongym.agents.dual_arm_map`)."""
 
     memory_class = DualArmMapMemory
+    check_kwargs = staticmethod(check_dual_arm_map_kwargs)
 
 
 class MapMemoryPredictor:
@@ -256,13 +260,8 @@ MEMORIES: dict[str, type[MemoryWrapper]] = {
     "sweeper_map": MapMemoryWrapper,
     "dual_arm_map": DualArmMapWrapper,
 }
-# Each memory's keyword check (defaults filled in).
-MEMORY_KWARGS_CHECKS = {
-    "sweeper_map": check_sweeper_map_kwargs,
-    "dual_arm_map": check_dual_arm_map_kwargs,
-}
 
 
 def check_memory_kwargs(kwargs: dict[str, Any], memory: str = "sweeper_map") -> dict[str, Any]:
     """``memory``'s settings checked, defaults filled in (an ``ArgumentError`` if bad)."""
-    return MEMORY_KWARGS_CHECKS[memory](kwargs)
+    return MEMORIES[memory].check_kwargs(kwargs)
