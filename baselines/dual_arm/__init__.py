@@ -12,6 +12,7 @@ POLICIES: dict[str, dict[str, str]] = {
         "sequential": f"{_MODULE}:SequentialPolicy",
         "min-makespan": f"{_MODULE}:MinMakespanPolicy",
         "undelayed": f"{_MODULE}:UndelayedPolicy",
+        "either-waits": f"{_MODULE}:EitherWaitsPolicy",
     },
 }
 POLICIES["motiongym/DualArmCell-v1"] = dict(POLICIES["motiongym/DualArmCell-v0"])

@@ -19,6 +19,12 @@ at ``p2 = 0`` that is exactly the pure delay ``x`` being free, so the
 first step at which a waiting robot 2 sees row 0 clear is the minimum start
 delay (:func:`.exact_delay.true_min_delay`, tested).
 
+The roles follow the trajectories' order: ``LagMap(traj2, traj1, ...)`` is
+the same map with robot 1 as the one that waits (:class:`.step_check.StepCheck`
+takes either order), for a policy that may let either robot yield
+(``either-waits`` in :mod:`.policies`). :meth:`LagMap.free_lags` gives every
+wait at once, for the smallest one.
+
 The table holds the states a pure delay visits. Where robot 2 is off them
 (stopped part-way, or at a fractional sample after an advance below 1), a
 step is read as the neighbouring columns (colliding if either does): an
@@ -55,7 +61,8 @@ class LagMap:
     """One episode's step table and the lag map read from it (module docstring).
 
     Args:
-        traj1, traj2: the two arms' trajectories.
+        traj1, traj2: the two arms' trajectories, in either order: ``traj1``'s robot
+            runs on, ``traj2``'s is the one that waits.
         margin: the environment's ``safety_margin`` (m).
         swept: v1's check (the motion of each step) if True, v0's (the step's end) if False.
     """
@@ -64,17 +71,20 @@ class LagMap:
         self, traj1: Trajectory, traj2: Trajectory, margin: float = 0.0, swept: bool = True
     ) -> None:
         self.n1, self.n2 = traj1.n_samples, traj2.n_samples
+        self.lead, self.wait = traj1.robot, traj2.robot
         self.table = (step_table if swept else sample_table)(traj1, traj2, margin)
 
     def state(self, observation: np.ndarray) -> tuple[int, float]:
-        """``(x, p2)`` from an observation's progress fields: robot 1's sample (rounded) and
-        robot 2's samples run (to 1e-3: the float32 observation reads a whole
-        sample as 244.000007)."""
+        """``(x, p2)`` from an observation's progress fields: the running robot's sample
+        (rounded) and the waiting robot's samples run (to 1e-3: the float32 observation
+        reads a whole sample as 244.000007)."""
         progress = np.asarray(observation, dtype=float)[OBS["progress"]]
-        return int(round(progress[0] * self.n1)), round(float(progress[1] * self.n2), 3)
+        x = int(round(progress[self.lead] * self.n1))
+        return x, round(float(progress[self.wait] * self.n2), 3)
 
-    def _columns(self, p2: float, i: np.ndarray, lag: int) -> tuple[np.ndarray, np.ndarray]:
-        """The two (possibly equal) columns read for robot 2 in step ``x + i``."""
+    def _columns(self, p2: float, i: np.ndarray, lag) -> tuple[np.ndarray, np.ndarray]:
+        """The two (possibly equal) columns read for robot 2 in step ``x + i`` (``lag`` an
+        int, or an array broadcasting against ``i``)."""
         n2 = self.n2
         base, frac = int(np.floor(p2)), p2 - np.floor(p2)
         moved = np.maximum(i - lag, 0)  # samples run since it went on
@@ -89,9 +99,10 @@ class LagMap:
         waiting = i < lag
         return np.where(waiting, still_lo, lo), np.where(waiting, still_hi, hi)
 
-    def blocked(self, x: int, p2: float, lag: int, horizon: int) -> np.ndarray:
+    def blocked(self, x: int, p2: float, lag, horizon: int) -> np.ndarray:
         """(horizon,) bool: does step ``x + i`` of "wait ``lag``, then go" collide?
-        Steps after both arms are done are clear."""
+        Steps after both arms are done are clear. ``lag`` may be an (L, 1) array: then
+        (L, horizon), one row per lag."""
         i = np.arange(horizon)
         rows = np.minimum(x + i, self.n1)
         lo, hi = self._columns(float(p2), i, lag)
@@ -103,6 +114,19 @@ class LagMap:
         """Is "go now at full speed" collision free until both arms are done?"""
         horizon = max(self.n1 - x, 0) + self.n2 + 2
         return not bool(self.blocked(x, p2, 0, horizon).any())
+
+    def free_lags(self, x: int, p2: float) -> np.ndarray:
+        """(L,) bool: is "wait ``w``, then go" collision free to the end, for ``w = 0 ..
+        L - 1`` where ``L - 1 = max(N1 - x, 0)`` (a longer wait only idles: the running
+        robot is at rest from there)?"""
+        lags = np.arange(max(self.n1 - x, 0) + 1)[:, None]
+        horizon = max(self.n1 - x, 0) * 2 + self.n2 + 2
+        return np.asarray(~self.blocked(x, p2, lags, horizon).any(axis=1), dtype=bool)
+
+    def min_wait(self, x: int, p2: float) -> int | None:
+        """The smallest free wait from ``(x, p2)`` (:meth:`free_lags`), None if none."""
+        found = np.flatnonzero(self.free_lags(x, p2))
+        return int(found[0]) if len(found) else None
 
     def window(
         self, x: int, p2: float, lags: Sequence[int], bin_steps: int, bins: int

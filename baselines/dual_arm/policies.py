@@ -15,7 +15,9 @@ minimum pure delay, :mod:`.bracket`), ``exhaustive-delay``
 (minimum delay over the full map), ``sequential`` (robot 2 starts when robot 1
 ends), ``min-makespan`` (robot 2 pauses and resumes on a shortest monotone
 path, beyond the paper), ``undelayed`` (both start together: collides on the
-sampled "colliding" pairs; a reference only).
+sampled "colliding" pairs; a reference only), ``either-waits`` (beyond the
+paper: either robot may be the one that waits, whichever finishes first;
+``control="both"`` only).
 """
 
 from __future__ import annotations
@@ -223,6 +225,69 @@ class MinMakespanPolicy(SchedulePolicy):
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
         found = schedules.min_makespan(cmap)
         return found if found is not None else schedules.sequential(cmap)
+
+
+class EitherWaitsPolicy(SchedulePolicy):
+    """Either robot may wait: the shortest makespan over both robots' pure delays.
+
+    Not the paper's method. The paper keeps robot 1 on its nominal schedule
+    and delays robot 2; whenever robot 1 waiting for robot 2 finishes sooner,
+    this policy lets robot 1 yield instead. Every step, from the current state
+    (both arms' progress in the observation), it reads both orders' lag maps
+    (:class:`.lag_map.LagMap`, on the environment's own check, v0's or v1's)
+    for each order's smallest collision-free wait ``w`` ("the yielding robot
+    waits ``w`` more steps, then both run at full speed") and takes the order
+    whose schedule ends first, robot 2 yielding on a tie (the paper's order).
+    The running robot advances; the yielding one only when its ``w`` is 0.
+    From the episode's start this is ``min(max(N1, D2 + N2), max(N2, D1 + N1))``
+    steps, ``D2`` and ``D1`` each order's minimum pure delay
+    (:func:`.exact_delay.true_min_delay` in either order), tested against
+    brute force in the environment. Where neither order has a free wait (the
+    arms collide at rest) robot 1 runs and robot 2 waits.
+
+    Needs ``control="both"``: under ``control="robot_2"`` robot 1 cannot yield.
+    """
+
+    def __init__(self, observation_space, action_space, env_kwargs=None, **kwargs):
+        super().__init__(observation_space, action_space, env_kwargs, **kwargs)
+        if action_space.shape != (2,):
+            raise ValueError(
+                f"either-waits moves both robots: it needs control='both' (an action of "
+                f"shape (2,)), got an action of shape {action_space.shape}"
+            )
+
+    def new_memory(self) -> dict[str, Any]:
+        return {**super().new_memory(), "lag_maps": None, "yields": None}
+
+    def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
+        obs = np.asarray(observation, dtype=float)
+        if memory["lag_maps"] is None:
+            traj1, traj2 = tasks_from_observation(obs)
+            memory["lag_maps"] = (
+                LagMap(traj1, traj2, self.safety_margin, self.swept),  # robot 2 yields
+                LagMap(traj2, traj1, self.safety_margin, self.swept),  # robot 1 yields
+            )
+        best = None
+        for lag_map in memory["lag_maps"]:
+            x, p = lag_map.state(obs)
+            wait = lag_map.min_wait(x, p)
+            if wait is None:
+                continue
+            steps = max(lag_map.n1 - x, wait + int(np.ceil(lag_map.n2 - p - 1e-9)))
+            if best is None or steps < best[0]:
+                best = (steps, lag_map.wait, wait)
+        action = np.array([1.0, 0.0], dtype=np.float32)
+        if best is not None:
+            _, yielding, wait = best
+            memory["yields"] = yielding
+            action = np.ones(2, dtype=np.float32)
+            action[yielding] = 1.0 if wait == 0 else 0.0
+        return action
+
+    def describe(self, memory: dict[str, Any]) -> dict[str, Any]:
+        """``yields``: the robot (0: robot 1, 1: robot 2) that the last step's chosen order
+        had wait, None before the first step or where neither order had a free wait."""
+        return {"yields": memory.get("yields")}
 
 
 class UndelayedPolicy(SchedulePolicy):

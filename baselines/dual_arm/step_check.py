@@ -11,6 +11,11 @@ row ``min(x, N1)``); robot 2, at full speed or waiting, is in one of
 over ``[k, k + 1]``, ``N2 + 1`` at rest at its end. Entry ``(row, col)`` is
 that step's verdict.
 
+The two roles are the trajectories' order, not the robots': ``StepCheck(traj2,
+traj1)`` (each trajectory on its own robot's base, ``Trajectory.robot``) is
+the table of robot 2 on its nominal schedule and robot 1 waiting or moving,
+for schedules in which robot 1 is the one that yields.
+
 Each entry is decided in two stages, as the environment decides a step:
 
 1. *Screen*: the 25 link distances at the step's two end configurations
@@ -46,7 +51,8 @@ class StepCheck:
     """Lazy verdicts of ``DualArmCell-v1``'s check for every (robot-1 step, robot-2 state).
 
     Args:
-        traj1, traj2: the two arms' trajectories.
+        traj1, traj2: the two arms' trajectories, one per robot, in either order: rows
+            are ``traj1``'s moves, columns ``traj2``'s states.
         margin: the safety margin (m), the environment's ``safety_margin``.
     Attributes:
         state: (N1 + 1, N2 + 2) int8, ``UNKNOWN``, ``CLEAR``, ``HIT`` (an end
@@ -56,6 +62,12 @@ class StepCheck:
     """
 
     def __init__(self, traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> None:
+        if {traj1.robot, traj2.robot} != {0, 1}:
+            raise ValueError(
+                f"a step check needs one trajectory per robot, got robots "
+                f"{traj1.robot} and {traj2.robot}"
+            )
+        self.swapped = traj1.robot == 1  # rows are robot 2's
         self.q1, self.q2 = traj1.samples(), traj2.samples()
         self.n1, self.n2 = len(self.q1) - 1, len(self.q2) - 1
         self.margin = float(margin)
@@ -65,8 +77,8 @@ class StepCheck:
         self.hi1 = np.minimum(self.lo1 + 1, n1)
         self.lo2 = np.concatenate([[0], np.arange(n2 + 1)])
         self.hi2 = np.concatenate([[0], np.minimum(np.arange(n2 + 1) + 1, n2)])
-        self.seg1 = model.link_segments(self.q1, model.base_transform(0))  # (N1+1, 5, 3) x2
-        self.seg2 = model.link_segments(self.q2, model.base_transform(1))
+        self.seg1 = model.link_segments(self.q1, model.base_transform(traj1.robot))  # (N1+1, 5, 3)
+        self.seg2 = model.link_segments(self.q2, model.base_transform(traj2.robot))
         self.centres1 = (self.seg1[0] + self.seg1[1]) / 2  # (N1 + 1, 5, 3)
         self.centres2 = (self.seg2[0] + self.seg2[1]) / 2
         self.move1 = motion.body_motion(np.abs(self.q1[self.hi1] - self.q1[self.lo1]))
@@ -152,7 +164,10 @@ class StepCheck:
         self.halvings += len(rows)
         spans1 = np.stack([self.lo1[rows], self.hi1[rows]], 1)
         spans2 = np.stack([self.lo2[cols], self.hi2[cols]], 1)
-        hit = motion.simultaneous_collide_many(self.q1, spans1, self.q2, spans2, self.margin)
+        if self.swapped:  # the routine takes robot 1's samples first; its halving is symmetric
+            hit = motion.simultaneous_collide_many(self.q2, spans2, self.q1, spans1, self.margin)
+        else:
+            hit = motion.simultaneous_collide_many(self.q1, spans1, self.q2, spans2, self.margin)
         self.state[rows, cols] = np.where(hit, COLLIDES, CLEAR)
 
     def table(self) -> np.ndarray:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+from dual_arm_runs import run_policy
 
 import motiongym  # noqa: F401
 from motiongym.baselines import make_policy, scripted_policies
@@ -16,18 +17,8 @@ EXPECTED = {  # success rate on sampled colliding pairs
     "sequential": 1.0,
     "min-makespan": 1.0,
     "undelayed": 0.0,
+    "either-waits": 1.0,
 }
-
-
-def _run(env, policy, seed, options=None):
-    obs, info = env.reset(seed=seed, options=options)
-    policy.reset()
-    done = False
-    while not done:
-        action, _ = policy.predict(obs)
-        obs, _, terminated, truncated, info = env.step(action)
-        done = terminated or truncated
-    return info
 
 
 def test_declared():
@@ -38,8 +29,12 @@ def test_declared():
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_success_rate(name, control):
     env = gym.make(ID, control=control)
+    if name == "either-waits" and control == "robot_2":
+        with pytest.raises(ValueError, match="control='both'"):
+            make_policy(ID, name, env.observation_space, env.action_space, {"control": control})
+        return
     policy = make_policy(ID, name, env.observation_space, env.action_space, {"control": control})
-    infos = [_run(env, policy, seed) for seed in range(4)]
+    infos = [run_policy(env, policy, seed) for seed in range(4)]
     assert np.mean([i["is_success"] for i in infos]) == EXPECTED[name]
 
 
@@ -48,7 +43,7 @@ def test_makespans_ordered_on_the_paper_case():
     span = {}
     for name in ("boundary-following", "exhaustive-delay", "sequential", "min-makespan"):
         policy = make_policy(ID, name, env.observation_space, env.action_space, {})
-        info = _run(env, policy, 0, {"task": "paper"})
+        info = run_policy(env, policy, 0, {"task": "paper"})
         assert info["is_success"]
         span[name] = info["makespan"]
     assert span["boundary-following"] == span["exhaustive-delay"]
