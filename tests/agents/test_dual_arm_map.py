@@ -16,6 +16,7 @@ from motiongym.agents.dual_arm_map import check_dual_arm_map_kwargs
 from motiongym.agents.map_memory import DualArmMapWrapper, MapMemoryPredictor
 from motiongym.baselines import make_policy
 from motiongym.envs.core import ArgumentError
+from motiongym.envs.dual_arm.world import tasks_from_observation
 
 V1 = "motiongym/DualArmCell-v1"
 
@@ -37,6 +38,34 @@ def test_the_view_shows_which_delays_the_environment_runs_clear():
     bare = gym.make(V1)
     assert run_pure_delay(bare, 100001, x)
     assert not run_pure_delay(bare, 100001, x - 1)
+
+
+def test_the_either_view_shows_both_orders():
+    """``yielding: either``: progress, remaining samples, then per order (robot 2 waiting,
+    then robot 1 waiting) its smallest free wait, when both are done after it, and its
+    rows. At the start of scene 100001 each order's smallest free wait is the pure delay of
+    that robot that the environment runs clear (and one step less collides), and its
+    finishing step the run's length; the robot-2 rows are the default view's."""
+    lags, bins = [0, 4], 64
+    env = DualArmMapWrapper(gym.make(V1), lags=lags, bins=bins, yielding="either")
+    plain = DualArmMapWrapper(gym.make(V1), lags=lags, bins=bins)
+    rows = len(lags) * (bins + 1)
+    assert env.observation_space.shape == (2 + 2 + 2 * (2 + rows) + 1,)
+    obs, _ = env.reset(seed=100001)
+    shown, _ = plain.reset(seed=100001)
+    assert np.array_equal(obs[6 : 6 + rows], shown[2:])
+    bare = gym.make(V1)
+    horizon = 8 * bins
+    n1, n2 = (t.n_samples for t in tasks_from_observation(bare.reset(seed=100001)[0]))
+    assert obs[2:4] == pytest.approx([n1 / horizon, n2 / horizon])
+    finish = []
+    for waiting, start, runs, waits in ((1, 4, n1, n2), (0, 6 + rows, n2, n1)):
+        wait = int(round(float(obs[start]) * horizon))
+        assert run_pure_delay(bare, 100001, wait, waiting=waiting), waiting
+        assert not run_pure_delay(bare, 100001, wait - 1, waiting=waiting), waiting
+        finish.append(max(runs, wait + waits))
+        assert round(float(obs[start + 1]) * 2 * horizon) == finish[-1]
+    assert obs[-1] == pytest.approx(0.5 + 0.5 * np.tanh((finish[1] - finish[0]) / 8))
 
 
 class _Echo:
@@ -83,6 +112,13 @@ def test_settings_and_environment_are_checked():
         check_dual_arm_map_kwargs({"bins": 0})
     with pytest.raises(ArgumentError, match="memory_kwargs.first_hit"):
         check_dual_arm_map_kwargs({"first_hit": "no"})
+    with pytest.raises(ArgumentError, match="memory_kwargs.sooner"):
+        check_dual_arm_map_kwargs({"sooner": 1})
+    wrapped = DualArmMapWrapper(gym.make(V1), yielding="either", sooner=False)
+    assert wrapped.observation_space.shape == (2 + 2 + 2 * (2 + 8 * 65),)
+    for bad in ("robot_1", 1, None):
+        with pytest.raises(ArgumentError, match="memory_kwargs.yielding must be one of"):
+            check_dual_arm_map_kwargs({"yielding": bad})
     assert DualArmMapWrapper(gym.make(V1), first_hit=False).observation_space.shape == (514,)
     with pytest.raises(ValueError, match="needs a dual-arm environment"):
         DualArmMapWrapper(gym.make("CartPole-v1"))
