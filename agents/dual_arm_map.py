@@ -147,21 +147,20 @@ class DualArmMapMemory:
             self.tasks = tasks
         horizon = self.bins * self.bin_steps
         parts = [obs[OBS["progress"]]]
-        if self.either:
-            lag_map = self.maps[0]
-            x, p2 = lag_map.state(obs)
+        states = [lag_map.state(obs) for lag_map in self.maps]
+        if self.either:  # each robot's remaining samples (the first order: robot 1 runs)
+            (x, p2), lag_map = states[0], self.maps[0]
             parts.append(np.array([lag_map.n1 - x, lag_map.n2 - p2]) / horizon)
         finish = []
-        for lag_map in self.maps:
-            x, p2 = lag_map.state(obs)
-            if self.either:
-                wait = lag_map.min_wait(x, p2)
-                if wait is None:
+        for lag_map, (x, p2) in zip(self.maps, states, strict=True):
+            if self.either:  # the smallest wait, and when both would be done after it
+                found = lag_map.finish(x, p2)
+                if found is None:  # no free wait: shown as the longest, ends after any other
+                    finish.append(4 * horizon)
                     parts.append([1.0, 1.0])
-                    finish.append(4.0 * horizon)
-                else:  # the wait, and when both would be done after it
-                    finish.append(max(lag_map.n1 - x, wait + np.ceil(lag_map.n2 - p2 - 1e-9)))
-                    parts.append([wait / horizon, finish[-1] / (2 * horizon)])
+                else:
+                    finish.append(found[1])
+                    parts.append([found[0] / horizon, found[1] / (2 * horizon)])
             view = lag_map.window(x, p2, self.lags, self.bin_steps, self.bins)
             parts.append((view if self.first_hit else view[:, :-1]).ravel())
         if self.sooner:  # how much sooner robot 2's yielding is done, squashed at a bin

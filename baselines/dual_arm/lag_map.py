@@ -22,8 +22,8 @@ delay (:func:`.exact_delay.true_min_delay`, tested).
 The roles follow the trajectories' order: ``LagMap(traj2, traj1, ...)`` is
 the same map with robot 1 as the one that waits (:class:`.step_check.StepCheck`
 takes either order), for a policy that may let either robot yield
-(``either-waits`` in :mod:`.policies`). :meth:`LagMap.free_lags` gives every
-wait at once, for the smallest one.
+(``either-waits`` in :mod:`.policies`). :meth:`LagMap.finish` gives the
+smallest free wait and when both arms would be done after it.
 
 The table holds the states a pure delay visits. Where robot 2 is off them
 (stopped part-way, or at a fractional sample after an advance below 1), a
@@ -115,18 +115,34 @@ class LagMap:
         horizon = max(self.n1 - x, 0) + self.n2 + 2
         return not bool(self.blocked(x, p2, 0, horizon).any())
 
-    def free_lags(self, x: int, p2: float) -> np.ndarray:
-        """(L,) bool: is "wait ``w``, then go" collision free to the end, for ``w = 0 ..
-        L - 1`` where ``L - 1 = max(N1 - x, 0)`` (a longer wait only idles: the running
-        robot is at rest from there)?"""
-        lags = np.arange(max(self.n1 - x, 0) + 1)[:, None]
-        horizon = max(self.n1 - x, 0) * 2 + self.n2 + 2
-        return np.asarray(~self.blocked(x, p2, lags, horizon).any(axis=1), dtype=bool)
+    def free_lags(self, x: int, p2: float, lags: np.ndarray | None = None) -> np.ndarray:
+        """bool per wait ``w`` of ``lags`` (default ``0 .. max(N1 - x, 0)``: a longer wait
+        only idles, the running robot being at rest from there): is "wait ``w``, then go"
+        collision free to the end?"""
+        last = max(self.n1 - x, 0)
+        lags = np.arange(last + 1) if lags is None else np.asarray(lags)
+        horizon = last + int(lags.max(initial=0)) + self.n2 + 2
+        return np.asarray(~self.blocked(x, p2, lags[:, None], horizon).any(axis=1), dtype=bool)
 
-    def min_wait(self, x: int, p2: float) -> int | None:
-        """The smallest free wait from ``(x, p2)`` (:meth:`free_lags`), None if none."""
-        found = np.flatnonzero(self.free_lags(x, p2))
-        return int(found[0]) if len(found) else None
+    def min_wait(self, x: int, p2: float, chunk: int = 32) -> int | None:
+        """The smallest free wait from ``(x, p2)`` (:meth:`free_lags`), None if none; the
+        waits are tried ``chunk`` at a time, shortest first (most are short)."""
+        last = max(self.n1 - x, 0)
+        for start in range(0, last + 1, chunk):
+            lags = np.arange(start, min(start + chunk, last + 1))
+            free = self.free_lags(x, p2, lags)
+            if free.any():
+                return int(lags[np.argmax(free)])
+        return None
+
+    def finish(self, x: int, p2: float) -> tuple[int, int] | None:
+        """``(w, steps)``: the smallest free wait from ``(x, p2)`` and the steps until both
+        arms are done after it (the running robot's rest of its path, or the wait plus
+        the waiting robot's); None where no wait is free."""
+        wait = self.min_wait(x, p2)
+        if wait is None:
+            return None
+        return wait, max(self.n1 - x, wait + int(np.ceil(self.n2 - p2 - 1e-9)))
 
     def window(
         self, x: int, p2: float, lags: Sequence[int], bin_steps: int, bins: int

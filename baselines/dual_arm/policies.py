@@ -39,6 +39,15 @@ from motiongym.envs.dual_arm.task import DT
 from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
 
 
+def environment_check(env_kwargs: dict[str, Any]) -> tuple[float, bool]:
+    """``(safety_margin, swept)`` of the environment made with ``env_kwargs``: its margin
+    (m) and whether it checks the motion between samples (v1) or the samples (v0)."""
+    params = params_from_kwargs(
+        DualArmParams, env_kwargs, ignore=("render_mode", "max_episode_steps")
+    )
+    return params.safety_margin, params.collision_check == "swept"
+
+
 class SchedulePolicy(ScriptedPolicy):
     """Base: plan robot 2's schedule on the episode's first step, then replay it.
 
@@ -70,12 +79,8 @@ class SchedulePolicy(ScriptedPolicy):
         if action_space.shape not in ((1,), (2,)):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
-        params = params_from_kwargs(
-            DualArmParams, self.env_kwargs, ignore=("render_mode", "max_episode_steps")
-        )
-        self.safety_margin = params.safety_margin
         # v1 checks the motion between samples: plan on the swept (conservative) map.
-        self.swept = params.collision_check == "swept"
+        self.safety_margin, self.swept = environment_check(self.env_kwargs)
         self.margin = self.safety_margin + float(plan_margin)
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 
@@ -227,7 +232,7 @@ class MinMakespanPolicy(SchedulePolicy):
         return found if found is not None else schedules.sequential(cmap)
 
 
-class EitherWaitsPolicy(SchedulePolicy):
+class EitherWaitsPolicy(ScriptedPolicy):
     """Either robot may wait: the shortest makespan over both robots' pure delays.
 
     Not the paper's method. The paper keeps robot 1 on its nominal schedule
@@ -236,8 +241,9 @@ class EitherWaitsPolicy(SchedulePolicy):
     (both arms' progress in the observation), it reads both orders' lag maps
     (:class:`.lag_map.LagMap`, on the environment's own check, v0's or v1's)
     for each order's smallest collision-free wait ``w`` ("the yielding robot
-    waits ``w`` more steps, then both run at full speed") and takes the order
-    whose schedule ends first, robot 2 yielding on a tie (the paper's order).
+    waits ``w`` more steps, then both run at full speed") and when both arms
+    would be done after it (:meth:`.lag_map.LagMap.finish`), and takes the order
+    that ends first, robot 2 yielding on a tie (the paper's order).
     The running robot advances; the yielding one only when its ``w`` is 0.
     From the episode's start this is ``min(max(N1, D2 + N2), max(N2, D1 + N1))``
     steps, ``D2`` and ``D1`` each order's minimum pure delay
@@ -246,18 +252,25 @@ class EitherWaitsPolicy(SchedulePolicy):
     arms collide at rest) robot 1 runs and robot 2 waits.
 
     Needs ``control="both"``: under ``control="robot_2"`` robot 1 cannot yield.
+    It plans on no map, so it takes none of the map policies' settings.
     """
 
-    def __init__(self, observation_space, action_space, env_kwargs=None, **kwargs):
-        super().__init__(observation_space, action_space, env_kwargs, **kwargs)
+    def __init__(
+        self,
+        observation_space: spaces.Space,
+        action_space: spaces.Space,
+        env_kwargs: dict[str, Any] | None = None,
+    ) -> None:
+        super().__init__(observation_space, action_space, env_kwargs)
         if action_space.shape != (2,):
             raise ValueError(
                 f"either-waits moves both robots: it needs control='both' (an action of "
                 f"shape (2,)), got an action of shape {action_space.shape}"
             )
+        self.safety_margin, self.swept = environment_check(self.env_kwargs)
 
     def new_memory(self) -> dict[str, Any]:
-        return {**super().new_memory(), "lag_maps": None, "yields": None}
+        return {"lag_maps": None, "yields": None}
 
     def act(self, observation: Any, memory: dict[str, Any]) -> np.ndarray:
         obs = np.asarray(observation, dtype=float)
@@ -267,21 +280,17 @@ class EitherWaitsPolicy(SchedulePolicy):
                 LagMap(traj1, traj2, self.safety_margin, self.swept),  # robot 2 yields
                 LagMap(traj2, traj1, self.safety_margin, self.swept),  # robot 1 yields
             )
-        best = None
+        best = None  # (steps, yielding robot, wait)
         for lag_map in memory["lag_maps"]:
-            x, p = lag_map.state(obs)
-            wait = lag_map.min_wait(x, p)
-            if wait is None:
-                continue
-            steps = max(lag_map.n1 - x, wait + int(np.ceil(lag_map.n2 - p - 1e-9)))
-            if best is None or steps < best[0]:
-                best = (steps, lag_map.wait, wait)
-        action = np.array([1.0, 0.0], dtype=np.float32)
-        if best is not None:
-            _, yielding, wait = best
-            memory["yields"] = yielding
-            action = np.ones(2, dtype=np.float32)
-            action[yielding] = 1.0 if wait == 0 else 0.0
+            found = lag_map.finish(*lag_map.state(obs))
+            if found is not None and (best is None or found[1] < best[0]):
+                best = (found[1], lag_map.wait, found[0])
+        if best is None:
+            return np.array([1.0, 0.0], dtype=np.float32)
+        _, yielding, wait = best
+        memory["yields"] = yielding
+        action = np.ones(2, dtype=np.float32)
+        action[yielding] = 1.0 if wait == 0 else 0.0
         return action
 
     def describe(self, memory: dict[str, Any]) -> dict[str, Any]:
