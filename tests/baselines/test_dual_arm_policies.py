@@ -30,12 +30,24 @@ def test_declared():
 def test_success_rate(name, control):
     env = gym.make(ID, control=control)
     if name == "either-waits" and control == "robot_2":
-        with pytest.raises(ValueError, match="control='both'"):
-            make_policy(ID, name, env.observation_space, env.action_space, {"control": control})
-        return
+        pytest.skip("test_either_waits_needs_both_arms_and_no_map_settings")
     policy = make_policy(ID, name, env.observation_space, env.action_space, {"control": control})
     infos = [run_policy(env, policy, seed) for seed in range(4)]
     assert np.mean([i["is_success"] for i in infos]) == EXPECTED[name]
+
+
+def test_either_waits_needs_both_arms_and_no_map_settings():
+    """Under control="robot_2" robot 1 cannot yield; and either-waits plans on no map, so a
+    map policy's setting is an error naming it, not silently ignored."""
+    env = gym.make(ID, control="robot_2")
+    with pytest.raises(ValueError, match="control='both'"):
+        make_policy(
+            ID, "either-waits", env.observation_space, env.action_space, {"control": "robot_2"}
+        )
+    env = gym.make(ID)
+    for setting in ({"plan_margin": 0.01}, {"n_levels": 50}, {"verify": False}):
+        with pytest.raises(TypeError, match=next(iter(setting))):
+            make_policy(ID, "either-waits", env.observation_space, env.action_space, {}, **setting)
 
 
 def test_makespans_ordered_on_the_paper_case():
