@@ -1,217 +1,157 @@
-"""What every motiongym world does the same way: one place, one message style.
+"""The contract every motiongym world obeys: a World, a Task and one base environment.
 
-* **Arguments.** :func:`check_choice`, :func:`check_int`, :func:`check_float`,
-  :func:`check_bool`, :func:`check_shape` validate one keyword argument or
-  reset option and raise :class:`ArgumentError` (a ``ValueError``) whose
-  message names the argument, what was given and what is allowed::
+A system is three parts (panda-gym's robot / task / simulator split,
+HighwayEnv's small base with a short list of hooks):
 
-      dof must be an integer in [3, 5], got 5.5
+* a **World** (:class:`World`): the state and its dynamics, the only code
+  that moves state or talks to MuJoCo or the grid. ``reset(scene, rng)``
+  puts a scene in place (``rng`` is the episode's generator, the only
+  source of a world's noise); ``advance(action) -> events`` moves it by one
+  control step and says what happened in it (contacts, cuts, bumps),
+  including between samples. It owns ``action_space`` and, where it draws,
+  ``render(size) -> frame``.
+* a **Task** (:class:`Task`): ``sample(rng, options) -> scene``;
+  ``begin(world) -> Outcome`` (the reset's, every reward term 0) and
+  ``evaluate(world, events) -> Outcome`` (reward terms, success, safety
+  cost, measures, terminated); ``observe(world)`` the observation. It owns
+  ``observation_space``, ``reward_terms`` and its reset ``options``; it
+  reads the world and never moves it.
+* an **environment**: a subclass of :class:`SystemEnv` naming its
+  parameters dataclass (``Params``) and building its world and task
+  (:meth:`SystemEnv.make_world`, :meth:`SystemEnv.make_task`). Its class
+  is metadata and a docstring: the base owns construction from keywords
+  (checked once), ``reset``, ``step``, ``info``, the cost, truncation (left
+  to ``TimeLimit``) and rendering.
 
-  A system's frozen parameters dataclass calls them in ``__post_init__``; the
-  environment and its scripted policies build that one dataclass from the
-  same keyword arguments (:func:`params_from_kwargs`), so a default is written
-  once and a bad value is refused at construction, never per step.
-* **Render mode and reset options.** :func:`check_render_mode` and
-  :func:`check_options` (``options`` must be ``None`` or a dict whose keys are
-  declared).
-* **Reward terms.** :func:`reward_and_info`: named terms whose sum, in their
-  declared order, is the reward; ``info`` gets ``reward_<term>`` for each, the
-  safety ``cost`` and ``is_success`` beside the world's measures.
-* **Observation layout.** :class:`ObservationLayout`: named fields with a
-  shape, a unit and a meaning; it packs (every field written, nothing else),
-  parses (Meta-World's check: the fields cover the whole vector), sets bounds
-  and writes the docstring's table.
-* **Reset before step.** :class:`NeedsReset` raises a clear error from an
-  unwrapped ``step()`` / ``render()`` before the first ``reset()``.
+Conventions decided once here for every world (``docs/adding_a_world.md``):
+
+* keyword style: ``Env(render_mode=None, **kwargs)``; every other keyword
+  is a field of the frozen ``Params`` dataclass, written with its default
+  and unit there only, checked in its ``__post_init__``;
+* reward: named terms whose sum, in their order, is the reward; weights are
+  magnitudes (:func:`check_weight`), costs subtracted; ``info`` holds
+  ``reward_<term>`` for each, ``is_success``, the Safety-Gymnasium ``cost``
+  and the task's measures;
+* render size: ``render_size`` = ``(rows, columns)`` (:func:`check_render_size`);
+* the start pose: the reset option :data:`START` (the world's own
+  coordinates: joint angles for an arm, the footprint's cell for the sweeper);
+* observations: every Box observation is described by one
+  :class:`ObservationLayout`;
+* errors: one :class:`ArgumentError` message style (:mod:`.checks`); a
+  deprecated name warns once (:class:`Deprecated`).
 """
 
 from __future__ import annotations
 
-import dataclasses
-import math
-import numbers
-from collections.abc import Callable, Iterable, Mapping, Sequence
-from typing import Any, TypeVar
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any, ClassVar, NamedTuple, Protocol, runtime_checkable
 
+import gymnasium as gym
 import numpy as np
+from gymnasium import spaces
+
+from motiongym.envs.actions import checked_box_action
+from motiongym.envs.checks import (
+    MAX_WEIGHT,
+    RENDER_SIDE,
+    ArgumentError,
+    Deprecated,
+    MotiongymDeprecationWarning,
+    check_bool,
+    check_choice,
+    check_float,
+    check_int,
+    check_keys,
+    check_options,
+    check_render_mode,
+    check_render_size,
+    check_shape,
+    check_weight,
+    params_from_kwargs,
+    warn_deprecated,
+)
+from motiongym.envs.layout import Field, ObservationLayout
+from motiongym.envs.rendering import Renders
+
+__all__ = [
+    "MAX_WEIGHT",
+    "RENDER_SIDE",
+    "START",
+    "ArgumentError",
+    "Deprecated",
+    "Field",
+    "MotiongymDeprecationWarning",
+    "NeedsReset",
+    "ObservationLayout",
+    "Outcome",
+    "SystemEnv",
+    "Task",
+    "World",
+    "add_reward_terms",
+    "check_bool",
+    "check_choice",
+    "check_float",
+    "check_int",
+    "check_keys",
+    "check_options",
+    "check_render_mode",
+    "check_render_size",
+    "check_shape",
+    "check_weight",
+    "params_from_kwargs",
+    "reward_and_info",
+    "warn_deprecated",
+    "zero_terms",
+]
+
+START = "start"  # the reset option that fixes the start pose, in every world
 
 
-class ArgumentError(ValueError):
-    """A keyword argument, reset option or action outside what is allowed."""
+# ---------------------------------------------------------------- the protocols
 
 
-def _fail(name: str, allowed: str, value: Any) -> ArgumentError:
-    return ArgumentError(f"{name} must be {allowed}, got {value!r}")
+class Outcome(NamedTuple):
+    """What a task makes of a step (or of the reset, with every term 0)."""
+
+    terms: Mapping[str, float]  # reward terms in order; their sum is the reward
+    success: bool  # info["is_success"]
+    cost: float  # info["cost"]: 1.0 on a step that collides or violates a safety distance
+    measures: Mapping[str, Any]  # the task's info keys
+    terminated: bool
 
 
-# ---------------------------------------------------------------- arguments
+@runtime_checkable
+class World(Protocol):
+    """The state and its dynamics (see the module docstring)."""
+
+    action_space: spaces.Space
+
+    def reset(self, scene: Any, rng: np.random.Generator) -> None:
+        """Put ``scene`` in place; ``rng`` is the episode's generator."""
+
+    def advance(self, action: Any) -> Any:
+        """Move the state by one control step under a checked ``action``; return its events."""
 
 
-def check_choice(name: str, value: Any, choices: Iterable[Any]) -> Any:
-    """``value`` if it is one of ``choices`` (compared with ``==`` and same type)."""
-    choices = tuple(choices)
-    for choice in choices:
-        if type(value) is type(choice) and value == choice:
-            return value
-    listed = ", ".join(repr(c) for c in choices)
-    raise _fail(name, f"one of {listed}", value)
+@runtime_checkable
+class Task(Protocol):
+    """What the episode asks of the world (see the module docstring)."""
 
+    observation_space: spaces.Space
+    reward_terms: tuple[str, ...]
+    options: Mapping[str, Callable[[str, Any], Any]]  # reset option -> its check
 
-def check_bool(name: str, value: Any) -> bool:
-    """``value`` if it is a ``bool`` (or NumPy bool): no truthy strings or numbers."""
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    raise _fail(name, "True or False", value)
+    def sample(self, rng: np.random.Generator, options: Mapping[str, Any]) -> Any:
+        """The episode's scene, drawn from ``rng`` only, fixed where ``options`` say."""
 
+    def begin(self, world: Any) -> Outcome:
+        """Start the episode on the reset world: per-episode state, the reset's outcome."""
 
-def check_int(name: str, value: Any, low: int | None = None, high: int | None = None) -> int:
-    """``value`` as an ``int`` in ``[low, high]`` (either bound may be open: None).
+    def evaluate(self, world: Any, events: Any) -> Outcome:
+        """The outcome of the step that produced ``events``."""
 
-    Floats are refused even when whole (``5.0``): an integer argument is a
-    count or an index, and a float there is a mistake worth naming.
-    """
-    allowed = _interval("an integer", low, high, closed=(True, True))
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
-        raise _fail(name, allowed, value)
-    v = int(value)
-    if (low is not None and v < low) or (high is not None and v > high):
-        raise _fail(name, allowed, value)
-    return v
-
-
-def check_float(
-    name: str,
-    value: Any,
-    low: float | None = None,
-    high: float | None = None,
-    *,
-    low_open: bool = False,
-    high_open: bool = False,
-) -> float:
-    """``value`` as a finite ``float`` in the interval (bounds open where said)."""
-    allowed = _interval("a finite number", low, high, closed=(not low_open, not high_open))
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise _fail(name, allowed, value)
-    v = float(value)
-    if not math.isfinite(v):
-        raise _fail(name, allowed, value)
-    if low is not None and (v < low or (low_open and v == low)):
-        raise _fail(name, allowed, value)
-    if high is not None and (v > high or (high_open and v == high)):
-        raise _fail(name, allowed, value)
-    return v
-
-
-def check_shape(
-    name: str, value: Any, shape: tuple[int | None, ...], *, finite: bool = True
-) -> np.ndarray:
-    """``value`` as a float64 array of ``shape`` (None: any length), finite if asked."""
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise _fail(name, f"an array of shape {_shape_text(shape)}", value) from None
-    if a.ndim != len(shape) or any(
-        s is not None and s != n for s, n in zip(shape, a.shape, strict=True)
-    ):
-        raise _fail(name, f"an array of shape {_shape_text(shape)}", value)
-    if finite and not np.isfinite(a).all():
-        raise _fail(name, "finite (no NaN or inf)", value)
-    return a
-
-
-def _shape_text(shape: tuple[int | None, ...]) -> str:
-    return (
-        "("
-        + ", ".join("n" if s is None else str(s) for s in shape)
-        + ("," if len(shape) == 1 else "")
-        + ")"
-    )
-
-
-def _interval(kind: str, low: Any, high: Any, closed: tuple[bool, bool]) -> str:
-    if low is None and high is None:
-        return kind
-    if high is None:
-        return f"{kind} {'>=' if closed[0] else '>'} {low}"
-    if low is None:
-        return f"{kind} {'<=' if closed[1] else '<'} {high}"
-    return f"{kind} in {'[' if closed[0] else '('}{low}, {high}{']' if closed[1] else ')'}"
-
-
-P = TypeVar("P")
-
-
-def params_from_kwargs(cls: type[P], kwargs: Mapping[str, Any], ignore: Iterable[str] = ()) -> P:
-    """Build the frozen parameters dataclass ``cls`` from an environment's keywords.
-
-    Keys in ``ignore`` (``render_mode``, say) are dropped; an unknown key is an
-    :class:`ArgumentError` listing the valid ones. Validation is the
-    dataclass's own ``__post_init__``.
-    """
-    fields = {f.name for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
-    ignored = set(ignore)
-    unknown = sorted(set(kwargs) - fields - ignored)
-    if unknown:
-        raise ArgumentError(
-            f"unknown keyword argument(s) {', '.join(unknown)}; valid: {', '.join(sorted(fields))}"
-        )
-    return cls(**{k: v for k, v in kwargs.items() if k in fields})
-
-
-# ---------------------------------------------------------------- render mode, options
-
-
-def check_render_mode(render_mode: Any, allowed: Sequence[str]) -> str | None:
-    """``render_mode`` if it is None or one of ``allowed``; ``"human"`` only where a
-    window can open (:func:`~motiongym.envs.rendering.missing_display`)."""
-    if render_mode is None:
-        return None
-    mode = check_choice("render_mode", render_mode, (None, *allowed))
-    if mode == "human":
-        from motiongym.envs.rendering import missing_display
-
-        problem = missing_display()
-        if problem is not None:
-            raise ArgumentError(
-                f"render_mode='human' needs a display to open a window ({problem}); "
-                "use render_mode='rgb_array' or `motiongym record`, or run under a "
-                "virtual display (xvfb-run)"
-            )
-    return mode
-
-
-def check_keys(name: str, value: Any, valid: Iterable[str]) -> dict[str, Any]:
-    """``value`` as a dict whose keys are all in ``valid`` (a settings mapping such as a
-    config's ``memory_kwargs``); anything but a mapping, or another key, is an
-    :class:`ArgumentError` naming ``name``."""
-    valid = list(valid)
-    if not isinstance(value, Mapping):
-        raise ArgumentError(f"{name} must be a mapping, got {value!r}")
-    unknown = sorted(set(value) - set(valid), key=str)
-    if unknown:
-        raise ArgumentError(f"unknown {name} key {unknown[0]!r}; valid: {', '.join(valid)}")
-    return dict(value)
-
-
-def check_options(
-    options: Any, validators: Mapping[str, Callable[[str, Any], Any]]
-) -> dict[str, Any]:
-    """Reset ``options`` as a dict of validated values.
-
-    ``validators`` maps each accepted key to ``check(name, value) -> value``
-    (one of this module's checks, partially applied); the name passed is
-    ``options['key']``. ``None`` is an empty dict; anything but a dict, or an
-    undeclared key, is an :class:`ArgumentError`.
-    """
-    if options is None:
-        return {}
-    if not isinstance(options, Mapping):
-        raise _fail("options", "None or a dict", options)
-    unknown = sorted(set(options) - set(validators), key=str)
-    if unknown:
-        valid = ", ".join(validators) or "none"
-        raise ArgumentError(f"unknown reset option(s) {unknown}; valid: {valid}")
-    return {key: validators[key](f"options[{key!r}]", value) for key, value in options.items()}
+    def observe(self, world: Any) -> Any:
+        """The observation of the world now (a fresh array or dict of arrays)."""
 
 
 # ---------------------------------------------------------------- reward terms
@@ -231,8 +171,7 @@ def reward_and_info(
 
 def add_reward_terms(info: dict[str, Any], terms: Mapping[str, float]) -> float:
     """Write ``reward_<term>`` for every term into ``info``; return the reward (their
-    sum, in their order). For a step that builds its ``info`` itself, in the layout of
-    :func:`reward_and_info`."""
+    sum, in their order)."""
     for key, value in terms.items():
         info[f"reward_{key}"] = float(value)
     return float(sum(terms.values()))
@@ -243,120 +182,14 @@ def zero_terms(names: Iterable[str]) -> dict[str, float]:
     return {name: 0.0 for name in names}
 
 
-# ---------------------------------------------------------------- observation layout
-
-
-@dataclasses.dataclass(frozen=True)
-class Field:
-    """One named part of a flat observation: its shape, unit and meaning."""
-
-    name: str
-    shape: tuple[int, ...]
-    unit: str = "-"
-    meaning: str = ""
-
-    @property
-    def size(self) -> int:
-        return int(np.prod(self.shape, dtype=np.int64))
-
-
-class ObservationLayout:
-    """A flat float32 observation as named fields, in order.
-
-    ``fields`` are :class:`Field` objects or ``(name, shape, unit, meaning)``
-    tuples (shape an int or a tuple). The same object builds the observation
-    (:meth:`pack`), reads it (:meth:`parse`), sets its bounds
-    (:meth:`bounds`) and documents it (:meth:`table`).
-    """
-
-    def __init__(self, fields: Iterable[Field | tuple]) -> None:
-        self.fields: tuple[Field, ...] = tuple(_as_field(f) for f in fields)
-        names = [f.name for f in self.fields]
-        if len(set(names)) != len(names):
-            raise ValueError(f"duplicate field names in {names}")
-        self.slices: dict[str, slice] = {}
-        start = 0
-        for f in self.fields:
-            self.slices[f.name] = slice(start, start + f.size)
-            start += f.size
-        self.size = start
-
-    def __getitem__(self, name: str) -> slice:
-        return self.slices[name]
-
-    def __contains__(self, name: str) -> bool:
-        return name in self.slices
-
-    def pack(self, parts: Mapping[str, Any], out: np.ndarray | None = None) -> np.ndarray:
-        """The observation from ``{name: value}``: every field, no other name."""
-        missing = [f.name for f in self.fields if f.name not in parts]
-        extra = sorted(set(parts) - set(self.slices))
-        if missing or extra:
-            raise ValueError(f"observation parts missing {missing}, unknown {extra}")
-        buf = np.empty(self.size, np.float32) if out is None else out
-        for f in self.fields:
-            buf[self.slices[f.name]] = np.ravel(parts[f.name])
-        return buf
-
-    def parse(self, observation: Any) -> dict[str, np.ndarray]:
-        """``{name: float64 array of the field's shape}``; the fields must cover the vector."""
-        o = np.asarray(observation, dtype=np.float64)
-        if o.shape != (self.size,):
-            raise ValueError(f"observation must have shape ({self.size},) to parse, got {o.shape}")
-        return {f.name: o[self.slices[f.name]].reshape(f.shape) for f in self.fields}
-
-    def bounds(self, limits: Mapping[str, tuple[Any, Any]]) -> tuple[np.ndarray, np.ndarray]:
-        """``(low, high)`` float32 arrays from ``{name: (low, high)}`` for every field."""
-        missing = [f.name for f in self.fields if f.name not in limits]
-        if missing:
-            raise ValueError(f"bounds missing for {missing}")
-        low = np.empty(self.size, np.float32)
-        high = np.empty(self.size, np.float32)
-        for f in self.fields:
-            lo, hi = limits[f.name]
-            low[self.slices[f.name]] = np.broadcast_to(np.ravel(lo), (f.size,))
-            high[self.slices[f.name]] = np.broadcast_to(np.ravel(hi), (f.size,))
-        return low, high
-
-    def table(self) -> str:
-        """A reStructuredText table (index, name, unit, meaning) for a docstring."""
-        rows = [("index", "name", "unit", "meaning")]
-        for f in self.fields:
-            s = self.slices[f.name]
-            index = str(s.start) if s.stop - s.start == 1 else f"{s.start}-{s.stop - 1}"
-            rows.append((index, f.name, f.unit, f.meaning))
-        widths = [max(len(r[i]) for r in rows) for i in range(4)]
-        rule = "  ".join("=" * w for w in widths)
-        lines = [
-            rule,
-            "  ".join(c.ljust(w) for c, w in zip(rows[0], widths, strict=True)).rstrip(),
-            rule,
-        ]
-        lines += [
-            "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip() for r in rows[1:]
-        ]
-        lines.append(rule)
-        return "\n".join(lines)
-
-
-def _as_field(f: Field | tuple) -> Field:
-    if isinstance(f, Field):
-        return f
-    name, shape, *rest = f
-    shape = (shape,) if isinstance(shape, int) else tuple(shape)
-    return Field(name, shape, *rest)
-
-
-# ---------------------------------------------------------------- reset before step
+# ---------------------------------------------------------------- the base environment
 
 
 class NeedsReset:
     """Mixin: ``self._require_reset("step")`` raises until ``self._was_reset`` is set.
 
-    An environment sets ``self._was_reset = True`` at the end of ``reset``
-    and calls ``self._require_reset(...)`` first in ``step`` and ``render``.
-    Gymnasium's ``OrderEnforcing`` wrapper does the same for ``gym.make``; this
-    guards the unwrapped class.
+    Gymnasium's ``OrderEnforcing`` wrapper does the same for ``gym.make``;
+    this guards the unwrapped class.
     """
 
     _was_reset: bool = False
@@ -364,3 +197,107 @@ class NeedsReset:
     def _require_reset(self, what: str) -> None:
         if not self._was_reset:
             raise RuntimeError(f"call reset() before {what}()")
+
+
+class SystemEnv(NeedsReset, Renders, gym.Env):
+    """The one base of every motiongym environment (see the module docstring).
+
+    A subclass sets ``Params`` (its frozen parameters dataclass, built by
+    :func:`params_from_kwargs`; ``render_mode`` is the only other keyword)
+    and implements :meth:`make_world` and :meth:`make_task`. Optional hooks:
+    :meth:`check_action` (the default checks the action against the world's
+    space and refuses it with a ``ValueError`` naming the space) and
+    ``ACTION_MEANING`` (what a Box action's entries are, for that message).
+
+    ``reset`` draws the scene from the task (``options`` checked against
+    ``task.options``, with ``task.deprecated_options`` where a task renamed
+    one), puts it in the world and returns the task's observation and the
+    reset's ``info``; ``step`` checks the action, advances the world, lets
+    the task evaluate the events and returns ``(observation, reward,
+    terminated, False, info)``: truncation is ``TimeLimit``'s.
+    """
+
+    Params: ClassVar[type]
+    ACTION_MEANING: ClassVar[str] = "the world's action"
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array", "human"], "render_fps": 30}
+
+    def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
+        self.params: Any = params_from_kwargs(self.Params, kwargs)
+        self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
+        self.world = self.make_world(self.params)
+        self.task = self.make_task(self.params)
+        self.action_space = self.world.action_space
+        self.observation_space = self.task.observation_space
+        self._discrete = isinstance(self.action_space, spaces.Discrete)
+
+    # ------------------------------------------------------------ hooks
+    def make_world(self, params: Any) -> World:
+        """The world of this environment (built once, reset every episode)."""
+        raise NotImplementedError
+
+    def make_task(self, params: Any) -> Task:
+        """The task of this environment."""
+        raise NotImplementedError
+
+    def check_action(self, action: Any) -> Any:
+        """``action`` as the world takes it, or a ``ValueError`` naming the space."""
+        space = self.action_space
+        if self._discrete:
+            try:
+                allowed = space.contains(action)
+            except (OverflowError, TypeError, ValueError):  # e.g. an int past int64
+                allowed = False
+            if not allowed:
+                raise ArgumentError(f"action must be in {space}, got {action!r}")
+            return int(action)
+        return checked_box_action(action, tuple(space.shape or ()), self.ACTION_MEANING)
+
+    # ------------------------------------------------------------ the loop
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        task = self.task
+        options = check_options(options, task.options, getattr(task, "deprecated_options", None))
+        super().reset(seed=seed)
+        scene = task.sample(self.np_random, options)
+        self.world.reset(scene, self.np_random)
+        outcome = task.begin(self.world)
+        self._was_reset = True
+        info = self._info(outcome)[1]
+        self._show_if_human()
+        return task.observe(self.world), info
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        self._require_reset("step")
+        events = self.world.advance(self.check_action(action))
+        outcome = self.task.evaluate(self.world, events)
+        reward, info = self._info(outcome)
+        self._show_if_human()
+        return self.task.observe(self.world), reward, outcome.terminated, False, info
+
+    def _info(self, outcome: Outcome) -> tuple[float, dict[str, Any]]:
+        """The reward and ``info`` of an outcome (``reward_<term>`` for every term)."""
+        info: dict[str, Any] = {
+            "is_success": bool(outcome.success),
+            "cost": float(outcome.cost),
+            **outcome.measures,
+        }
+        return add_reward_terms(info, outcome.terms), info
+
+    # ------------------------------------------------------------ rendering, state
+    @property
+    def scene(self) -> Any:
+        """The episode's scene (None before the first reset)."""
+        return getattr(self.world, "scene", None)
+
+    def _frame(self) -> np.ndarray:
+        render = getattr(self.world, "render", None)
+        if render is None:
+            raise NotImplementedError(f"{type(self.world).__name__} does not render")
+        return render(self.params.render_size)
+
+    def close(self) -> None:
+        close = getattr(self.world, "close", None)
+        if close is not None:
+            close()
+        super().close()
