@@ -45,23 +45,20 @@ from motiongym.baselines.harvest_arm.reference_velocity import (
 from motiongym.baselines.policy import ScriptedPolicy
 from motiongym.envs.core import check_bool, check_float, params_from_kwargs
 from motiongym.envs.harvest_arm.model import ArmKinematics
-from motiongym.envs.harvest_arm.observation import ObservationLayout
+from motiongym.envs.harvest_arm.observation import layout_for, observation_views
 from motiongym.envs.harvest_arm.params import HarvestArmParams
 
 GRIPPER_SPEED = 0.2  # m/s, |V_end_ref| (the paper does not give it) and every |V_i_ref|
 JOINT_DAMPING = 1e-3  # eq. 1's S1 + JOINT_DAMPING trace(S1)/n I: a small cost on joint rates
 """Without it the null space drifts along near-free joint combinations (the 7-DOF
 arm's waist and upper-arm roll) to their limits where the references cannot all
-be met; the fruit then ends out of reach (docs/experiments/HarvestArm-v1.md)."""
+be met; the fruit then ends out of reach."""
 ESCAPE_COSINE = 0.3
 """``markov`` with ``escape``: the vortex field acts where the plain field's cosine to the
-fruit direction is below this (held-out HarvestArmPlanar-v0: 97 % success, 86 % without,
-docs/experiments/HarvestArmPlanar-v0.md)."""
+fruit direction is below this."""
 RELAXED_GRIPPER_WEIGHT = 10.0
 """``critical_clearance``: the gripper's ``k_i`` in the unconstrained eq. 1 (the joint
-points' are 1, a link's control point's ``1 + |w_ob|``, 9 at 5 cm, 120 at 2 cm). It
-matters little: HarvestArm-v0, ``markov``, 0.03 m, development seeds 5000-5999: 96.9 /
-97.1 / 97.7 % success with 3 / 10 / 30, no collision with any."""
+points' are 1, a link's control point's ``1 + |w_ob|``, 9 at 5 cm, 120 at 2 cm)."""
 
 
 class _ArmPolicy(ScriptedPolicy):
@@ -79,7 +76,7 @@ class _ArmPolicy(ScriptedPolicy):
         self.link_radius, self.dt = params.link_radius, params.dt
         self.kin = ArmKinematics(self.arm, self.link_radius, self.dt)
         n_slots = params.n_obstacles
-        self.layout = ObservationLayout(self.arm.dof, self.arm.dim, self.kin.n_points, n_slots)
+        self.layout = layout_for(params)
         if observation_space.shape != (self.layout.size,):
             raise ValueError(
                 f"observation shape {observation_space.shape} does not match the arm "
@@ -107,7 +104,7 @@ class PotentialFieldPolicy(_ArmPolicy):
     (``|V_end_ref|`` times :func:`.potential_field.field_direction`; within
     one control period of the fruit, straight onto it). The action is then
     a function of the observation alone, a teacher DAgger can be taught by
-    (:mod:`motiongym.agents.dagger`); on its path the plan-keeping policy
+    (:mod:`motiongym.agents.training.dagger`); on its path the plan-keeping policy
     moves the same way (the plan is the RK4 integral of this field), off it
     the two differ. Its ``escape`` needs no memory: where the field leads
     less than :data:`ESCAPE_COSINE` towards the fruit (near a local
@@ -119,10 +116,8 @@ class PotentialFieldPolicy(_ArmPolicy):
     without its gripper constraint (:func:`.redundancy.relaxed_rates`, the
     gripper weighted :data:`RELAXED_GRIPPER_WEIGHT`), so the link's avoidance
     can take the gripper off its path; the paper's constraint leaves it only
-    the null space, which near these contacts cannot move the link away. On
-    HarvestArm-v0 (``markov``, development seeds 5000-5999): collisions 2.0 %
-    -> 0 % at 0.02 and 0.03 m, success 98.1 % -> 98.1 and 97.1 %
-    (docs/experiments/HarvestArm-v0.md).
+    the null space, which near these contacts may hold no motion that moves
+    the link away.
 
     :meth:`diagnostics` keys: ``path`` (N, dim) the planned gripper path,
     ``stalled`` (the path stopped in a local minimum), ``escapes`` (vortex
@@ -211,7 +206,7 @@ class PotentialFieldPolicy(_ArmPolicy):
         return GRIPPER_SPEED * direction
 
     def act(self, observation: np.ndarray, memory: dict[str, Any]) -> np.ndarray:
-        o = self.layout.parse(observation)
+        o = observation_views(self.layout, observation)
         points, jacs = self.kin.jacobians(o["q"])  # (P, dim), (P, dim, n)
         if self.markov:
             x_dot = self.field_velocity(o, points[-1])
@@ -303,7 +298,7 @@ class ResolvedRatePolicy(_ArmPolicy):
         return None
 
     def act(self, observation: np.ndarray, memory: None) -> np.ndarray:
-        o = self.layout.parse(observation)
+        o = observation_views(self.layout, observation)
         points, jacs = self.kin.jacobians(o["q"])
         to_fruit = o["fruit"] - points[-1]
         d = float(np.linalg.norm(to_fruit))

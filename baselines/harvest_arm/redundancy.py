@@ -28,10 +28,8 @@ reference velocity and ``k_i > 0`` its weight. This is the exact solution of
 * :func:`relaxed_rates` (not the paper's; the policies' ``critical_clearance``
   option): the same cost without the constraint, the gripper one more
   weighted point. Where a link is about to touch an obstacle, the null space
-  of ``Jn`` may hold no motion that takes it away (on HarvestArm-v0 scenes
-  where the field's teacher collides, the link point's clearance rate over
-  the null space is a tenth of its rate over all joint motions); dropping the
-  constraint lets the avoidance term move the gripper off its path.
+  of ``Jn`` may hold no motion that takes it away; dropping the constraint
+  lets the avoidance term move the gripper off its path.
 """
 
 from __future__ import annotations

@@ -12,16 +12,14 @@ from typing import Any
 
 from motiongym.envs.core import params_from_kwargs
 from motiongym.envs.goal import GoalFields
-from motiongym.envs.harvest_arm.model import ArmKinematics
-from motiongym.envs.harvest_arm.observation import ObservationLayout
+from motiongym.envs.harvest_arm.observation import layout_for
 from motiongym.envs.harvest_arm.params import HarvestArmParams
 
 
 def goal_fields(kwargs: dict[str, Any]) -> GoalFields:
     """The :class:`GoalFields` of the arm that ``kwargs`` (the env's keywords) build."""
     p = params_from_kwargs(HarvestArmParams, kwargs)
-    n_points = ArmKinematics(p.arm, p.link_radius, p.dt).n_points
-    layout = ObservationLayout(p.arm.dof, p.arm.dim, n_points, p.n_obstacles)
+    layout = layout_for(p)
     s, dim = layout.slices, p.arm.dim
     goal = slice(0, dim)
     return GoalFields(

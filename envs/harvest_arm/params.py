@@ -8,12 +8,21 @@ so every default is written here only.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
-from motiongym.envs.core import ArgumentError, check_bool, check_float, check_int
+from motiongym.envs.core import (
+    RENDER_SIDE,
+    ArgumentError,
+    Deprecated,
+    check_bool,
+    check_float,
+    check_int,
+    check_render_size,
+    check_weight,
+)
 from motiongym.envs.harvest_arm.model import PLANAR_DOFS, SPATIAL_DOFS, ArmSpec, arm_spec
 
 MAX_OBSTACLES = 32  # obstacle slots: L * K explicit contact pairs are evaluated every step
-MAX_RENDER_SIZE = 4096  # pixels per side
 REWARD_TERMS = ("progress", "clearance", "collision", "effort", "success", "distance")
 
 
@@ -26,6 +35,18 @@ def _int_given(name: str, value: object, bounds: tuple[int, ...], given: str) ->
         raise ArgumentError(f"{error} (with {given})") from None
 
 
+def _side(name: str) -> Any:
+    """Deprecated ``width`` / ``height``: that side of ``render_size``, checked under its
+    old name (so that a bad value is named as the user wrote it)."""
+    column = name == "width"
+
+    def convert(value: Any, current: tuple[int, int]) -> tuple[Any, Any]:
+        side = check_int(name, value, *RENDER_SIDE)
+        return (current[0], side) if column else (side, current[1])
+
+    return convert
+
+
 @dataclass(frozen=True)
 class HarvestArmParams:
     """Every keyword argument of :class:`~motiongym.envs.harvest_arm.env.HarvestArmEnv`.
@@ -35,8 +56,12 @@ class HarvestArmParams:
     (spatial), default 5 / 7; ``n_obstacles`` an integer in [1, 32], default
     8 / 10; ``n_bars`` in [0, n_obstacles], default 0 / 3; ``link_radius`` in
     (0, 0.1] m; ``dt`` in (0, 1] s; ``safety_distance`` in (0, 0.5] m;
-    ``success_tolerance`` in (0, 0.2] m; the reward weights finite;
-    ``width`` and ``height`` integers in [16, 4096].
+    ``success_tolerance`` in (0, 0.2] m; the reward weights magnitudes in
+    [0, 1e6] (:func:`~motiongym.envs.core.check_weight`); ``render_size``
+    ``(rows, columns)``, each in [16, 2048] pixels.
+
+    Deprecated (warn once, removed in the next release): ``width`` and
+    ``height`` (pixels), now ``render_size = (height, width)``.
     """
 
     # None given: the variant's default (ints after __post_init__)
@@ -50,14 +75,19 @@ class HarvestArmParams:
     success_tolerance: float = 0.02  # m, gripper to fruit centre
     terminate_on_collision: bool = True
     self_collision: bool = False
-    progress: float = 10.0
+    # reward weights (magnitudes; the env's docstring gives each term's sign)
+    progress: float = 10.0  # per m of approach to the fruit
     clearance: float = 1.0
     collision: float = 10.0
     effort: float = 0.01
     success: float = 10.0
-    distance: float = 0.0
-    width: int = 480
-    height: int = 360
+    distance: float = 0.0  # per m of gripper-fruit distance, every step
+    render_size: tuple[int, int] = (360, 480)  # pixels: rows, columns
+
+    DEPRECATED: ClassVar[dict[str, Deprecated]] = {
+        "width": Deprecated("render_size", _side("width"), "use render_size=(height, width)"),
+        "height": Deprecated("render_size", _side("height"), "use render_size=(height, width)"),
+    }
 
     def __post_init__(self) -> None:
         planar = check_bool("planar", self.planar)
@@ -84,11 +114,10 @@ class HarvestArmParams:
                 "terminate_on_collision", self.terminate_on_collision
             ),
             "self_collision": check_bool("self_collision", self.self_collision),
-            "width": check_int("width", self.width, 16, MAX_RENDER_SIZE),
-            "height": check_int("height", self.height, 16, MAX_RENDER_SIZE),
+            "render_size": check_render_size("render_size", self.render_size),
         }
         for term in REWARD_TERMS:
-            values[term] = check_float(term, getattr(self, term))
+            values[term] = check_weight(term, getattr(self, term))
         for name, value in values.items():
             object.__setattr__(self, name, value)
 

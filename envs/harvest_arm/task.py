@@ -1,4 +1,6 @@
-"""Scenes of the harvest-arm world: the fruit and the obstacles, sampled per reset.
+"""The harvest-arm task: scenes (the fruit and the obstacles, sampled per reset) and
+what the episode asks of the arm (:class:`HarvestArmTask`: reward terms, success,
+cost, the observation).
 
 The paper generates "8 random obstacles" in the plane and "10 random
 obstacles, 3 in 10 bars" in space, and does not say where. Our scene
@@ -24,19 +26,41 @@ distribution (fixed for the ``-v0`` IDs), a canopy around the fruit:
   reach the fruit's centre.
 
 Everything is drawn from the ``rng`` passed in (the env's ``np_random``).
+The start pose (reset option ``start``, default the arm's home pose) travels
+with the scene.
 """
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from gymnasium import spaces
 
-from motiongym.envs.core import ArgumentError, check_float, check_shape
+from motiongym.envs.core import (
+    START,
+    ArgumentError,
+    Deprecated,
+    Outcome,
+    check_float,
+    check_shape,
+    zero_terms,
+)
 from motiongym.envs.geometry import closest_point_on_segment, closest_points_between_segments
 from motiongym.envs.harvest_arm.model import REACH, ArmKinematics
-from motiongym.envs.harvest_arm.observation import POSITION_BOUND
+from motiongym.envs.harvest_arm.observation import (
+    POSITION_BOUND,
+    arm_bounds,
+    layout_for,
+    obstacle_width,
+)
+from motiongym.envs.harvest_arm.params import REWARD_TERMS, HarvestArmParams
+
+if TYPE_CHECKING:
+    from motiongym.envs.harvest_arm.world import ArmEvents, HarvestArmWorld
 
 FRUIT_RADIUS = 0.035  # m
 SPHERE_RADIUS = (0.01, 0.02)  # m, immature fruit
@@ -64,6 +88,7 @@ class Scene:
     b: np.ndarray  # (K, dim) m
     radius: np.ndarray  # (K,) m
     is_bar: np.ndarray  # (K,) bool
+    start: np.ndarray | None = None  # (n,) rad, the start pose (None: the arm's home pose)
 
     def __len__(self) -> int:
         return len(self.radius)
@@ -233,3 +258,145 @@ def sample_scene(
     radius = np.concatenate([p.radius for p in parts])
     is_bar = np.concatenate([p.is_bar for p in parts])
     return Scene(fruit, a, b, radius, is_bar)
+
+
+# ---------------------------------------------------------------- the task
+
+
+def _checked_in_sample(name: str, value: Any) -> Any:
+    """The reset option ``obstacles``: checked with the fruit, in :meth:`HarvestArmTask.sample`."""
+    return value
+
+
+class HarvestArmTask:
+    """Bring the gripper to the fruit, links clear of the obstacles (the env's docstring).
+
+    Scenes come from :func:`sample_scene` (or the reset options ``fruit`` and
+    ``obstacles``, :func:`scene_from_obstacles`), with the start pose
+    ``start``. The observation is :func:`~.observation.layout_for`'s layout:
+    the scene's part (fruit, obstacle slots, mask) is written at
+    :meth:`begin`, the arm's part at every :meth:`observe`.
+    """
+
+    reward_terms: tuple[str, ...] = REWARD_TERMS
+    deprecated_options: Mapping[str, Deprecated] = {"q": Deprecated(START)}
+
+    def __init__(self, params: HarvestArmParams, kinematics: ArmKinematics) -> None:
+        self.params = params
+        self.kinematics = kinematics  # forward kinematics and IK of scene sampling
+        arm = params.arm
+        n, dim = arm.dof, arm.dim
+        self.layout = layout_for(params)
+        low, high = arm_bounds(self.layout, arm.speeds)
+        self.observation_space: spaces.Space = spaces.Box(low, high, dtype=np.float32)
+        self.options: Mapping[str, Callable[[str, Any], Any]] = {  # partials: the env pickles
+            "fruit": functools.partial(check_position, dim=dim),
+            "obstacles": _checked_in_sample,
+            START: functools.partial(check_shape, shape=(n,)),
+        }
+        self._home = np.array(arm.home, float)
+        self._slots = (params.n_obstacles - params.n_bars, params.n_bars)
+        self._obs = np.zeros(self.layout.size, dtype=np.float32)
+        s = self.layout.slices
+        self._s_sin, self._s_cos, self._s_qdot = s["sin_q"], s["cos_q"], s["qdot"]
+        self._s_points, self._s_dist = s["points"], s["distances"]
+        self._s_fruit_error = s["fruit_error"]
+        self._fruit = np.zeros(dim)
+        self._d_fruit = self._min_so_far = 0.0
+
+    # ------------------------------------------------------------ the episode
+    def sample(self, rng: np.random.Generator, options: Mapping[str, Any]) -> Scene:
+        """A scene from ``rng`` (or the explicit ``fruit`` and ``obstacles``) and the
+        start pose (``start``, else the home pose)."""
+        if ("fruit" in options) != ("obstacles" in options):
+            raise ArgumentError("reset options 'fruit' and 'obstacles' must be given together")
+        p = self.params
+        if "fruit" in options:
+            scene = scene_from_obstacles(
+                options["fruit"], options["obstacles"], self.kinematics.dim, self._slots
+            )
+        else:
+            scene = sample_scene(rng, self.kinematics, p.n_obstacles, p.n_bars, p.link_radius)
+        scene.start = np.array(options.get(START, self._home), float)
+        return scene
+
+    def begin(self, world: HarvestArmWorld) -> Outcome:
+        """Write the scene's part of the observation; the reset's outcome (terms 0)."""
+        scene = world.scene
+        assert scene is not None
+        s = self.layout.slices
+        rows = np.zeros((len(world.slots), obstacle_width(len(scene.fruit))))
+        present = world.slots >= 0
+        k = world.slots[present]
+        rows[present] = np.concatenate(
+            [scene.a[k], scene.b[k], scene.radius[k, None], scene.is_bar[k, None]], axis=1
+        )
+        self._obs[s["fruit"]] = scene.fruit
+        self._obs[s["obstacles"]] = rows.ravel()
+        self._obs[s["mask"]] = present
+        self._fruit = scene.fruit.copy()
+        self._d_fruit = self._distance_to_fruit(world)
+        self._min_so_far = world.min_distance
+        return self._outcome(world, zero_terms(self.reward_terms), False, False, False)
+
+    def evaluate(self, world: HarvestArmWorld, events: ArmEvents) -> Outcome:
+        """The six reward terms of the step, success, cost and the measures."""
+        d_fruit = self._distance_to_fruit(world)
+        min_d = world.min_distance
+        if min_d < self._min_so_far:
+            self._min_so_far = min_d
+        collided = events.collided
+        p = self.params
+        arrived = d_fruit <= p.success_tolerance
+        a = events.action
+        terms = {  # weights are magnitudes: costs subtracted
+            "progress": p.progress * (self._d_fruit - d_fruit),
+            "clearance": -p.clearance * max(0.0, 1.0 - min_d / p.safety_distance),
+            "collision": -p.collision * float(collided),
+            "effort": -p.effort * float(np.dot(a, a)) / len(a),
+            "success": p.success * float(arrived),
+            "distance": -p.distance * d_fruit,
+        }
+        self._d_fruit = d_fruit
+        terminated = bool(arrived or (collided and p.terminate_on_collision))
+        return self._outcome(world, terms, arrived, collided, terminated)
+
+    def _outcome(
+        self,
+        world: HarvestArmWorld,
+        terms: dict[str, float],
+        arrived: bool,
+        collided: bool,
+        terminated: bool,
+    ) -> Outcome:
+        min_d = world.min_distance
+        close = min_d < self.params.safety_distance
+        measures: dict[str, Any] = {
+            "distance_to_fruit": self._d_fruit,
+            "min_distance": min_d,
+            "min_distance_so_far": self._min_so_far,
+            "close_approach": bool(close),
+            "collision": bool(collided),
+        }
+        if self.params.self_collision:
+            measures["self_distance"] = world.self_distance
+            measures["self_collision"] = bool(world.self_distance <= 0.0)
+        return Outcome(terms, arrived, 1.0 if close or collided else 0.0, measures, terminated)
+
+    def _distance_to_fruit(self, world: HarvestArmWorld) -> float:
+        g = world.points[-1] - self._fruit
+        return float(np.sqrt(g @ g))
+
+    # ------------------------------------------------------------ the observation
+    def observe(self, world: HarvestArmWorld) -> np.ndarray:
+        """The observation (a fresh float32 array): the scene's part from :meth:`begin`,
+        the arm's from the world now."""
+        obs, q = self._obs, world.q
+        obs[self._s_sin] = np.sin(q)
+        obs[self._s_cos] = np.cos(q)
+        obs[self._s_qdot] = world.qdot
+        points = world.points
+        obs[self._s_points] = points.ravel()
+        obs[self._s_fruit_error] = self._fruit - points[-1]
+        obs[self._s_dist] = world.clearances
+        return obs.copy()
