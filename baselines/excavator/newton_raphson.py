@@ -1,7 +1,7 @@
 """Newton-Raphson inverse kinematics of the excavator (paper eq. 9-13).
 
 The paper's section 4 (the error and the Jacobian, eq. 6-8) is missing from
-the text; we follow the reconstruction of ``../shared/specs/excavator.md``:
+the text; we reconstruct it as follows:
 
 * error matrix ``E = H(q) - H_d`` with ``H(q) = H_M^O T_4^M T_tip^4`` the
   bucket-tip frame (eq. 5) and ``H_d`` the desired one

@@ -91,7 +91,7 @@ class ReachPolicy(_ExcavatorPolicy):
             a funnel: 1 m above while far, down as the tip comes over the
             target), solved by IK from the current joints at every step: the
             action is a function of the observation alone, the labels a
-            DAgger learner needs (:mod:`motiongym.agents.dagger`).
+            DAgger learner needs (:mod:`motiongym.agents.training.dagger`).
     """
 
     TASK = "reach"
@@ -163,7 +163,7 @@ class DigCyclePolicy(_ExcavatorPolicy):
             this many radians of it (default ``REACHED``, 2 mrad). The plan is
             followed goal by goal, each passed only once reached, so an action
             changed after the policy chose it (a residual agent's correction,
-            :mod:`motiongym.agents.residual`) must not move the joints by more
+            :mod:`motiongym.agents.training.residual`) must not move the joints by more
             than the tolerance in a step: the dead-beat tracking
             (:func:`.tracking.track`) leaves the joints ``c * rate_max * dt``
             past the goal after a step with correction ``c``, so with the

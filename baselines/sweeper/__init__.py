@@ -22,5 +22,5 @@ POLICIES: dict[str, dict[str, str]] = {
 # plans online, while it senses: its "plan" is a whole run, timed through the one episode
 # loop (agents.sweeper_runs; a name the bench resolves, not an import of this package).
 PLANNERS: dict[str, tuple[str, float | None]] = {
-    "PSA + CWA, full run on the maze": ("motiongym.agents.sweeper_runs:sweep", 2.0),
+    "PSA + CWA, full run on the maze": ("motiongym.agents.reproduce.sweeper_runs:sweep", 2.0),
 }

@@ -40,13 +40,8 @@ Choices where the paper is open (documented and tested):
   configurations behind the lane known to be free and as long as the lane
   before, is pushed when it holds unswept cells. (Without it such a strip,
   one robot width wide along a wall, was left to CWA's scan, which found it
-  after the whole stack, usually from the far side of the map.) Mean travel
-  ratio over room seeds 0-19, maze seeds 0-19, apartment seeds 0-29 and the
-  reproduction's 50 procedural maps: 1.339 / 1.486 / 1.603 / 1.389 without,
-  1.337 / 1.490 / 1.554 / 1.381 with; apartment starts below the
-  exploration bound (:func:`motiongym.envs.sweeper.occupancy.smartdfs_bound`)
-  22 -> 27 of 30. Looking behind a restarted run's first lane as well cost
-  on the room (1.367) and gained little elsewhere; not done.
+  after the whole stack, usually from the far side of the map.) Only a
+  run's later lanes look behind, not its first one.
 - A pushed entry keeps its whole side segment (start, heading, length, side):
   on popping, the restart point is the end of the segment's still-unswept
   part that is nearer to the robot (the paper's "start point" taken from
@@ -77,21 +72,12 @@ Choices where the paper is open (documented and tested):
   (:func:`restart_heading`, :func:`sweep_cost`: ``ceil(across / w)`` lanes,
   so a corridor 7 cells wide is swept in lanes across it, each of which
   sweeps fresh floor, rather than in three lanes along it that sweep 9
-  rows for 7).
+  rows for 7). The restart heading is a local estimate: lanes turned
+  across one strip run on into the side corridors they meet. It is on by
+  default; ``PsaCwaPolicy.restart_axis`` switches it.
 
-  Mean travel ratio (travel / (area / w)) over seeds 0-9 on the room, the
-  apartment and the maze, and over the reproduction's 50 procedural maps:
-  plain stack order and segment heading 1.445 / 1.697 / 1.546 / 1.445;
-  LIFO by runs alone 1.365 / 1.636 / 1.537 / 1.422; restart heading alone
-  1.445 / 1.630 / 1.498 / 1.429; both 1.366 / 1.580 / 1.486 / 1.405. The
-  restart heading is a local estimate: lanes turned across one strip run on
-  into the side corridors they meet, so on the maze it widens the travel's
-  spread over start cells (299 starts heading east, (max - min) / min:
-  16.8 % plain, 13.3 % with LIFO by runs alone, 25.4 % with both; mean
-  travel 778, 773, 772 cells), while over random starts and headings it
-  lowers the travel (maze seeds 0-39: 1.538 -> 1.486, below SmartDFS's
-  bound from 1 -> 12 starts; apartment seeds 10-39: 1.647 -> 1.617), so it
-  is on by default; ``PsaCwaPolicy.restart_axis`` switches it.
+The travel each of these choices saves (or costs) is measured in
+``docs/experiments/Sweeper-v0.md``.
 """
 
 from __future__ import annotations

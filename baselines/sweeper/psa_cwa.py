@@ -61,8 +61,8 @@ from motiongym.envs.sweeper.world import FORWARD, LEFT
 
 EVIDENCE = 4  # votes a map cell holds at most when localising (belief.RobotMap)
 MAX_STALLS = 20  # scans without progress a localising policy makes before it declares done
-MAX_ROUNDS = 50  # mode changes per step (settled within 15 where measured), then move on
-PARTICLE_VOTES = EVIDENCE  # per particle's map (fastslam.py); 1 and 100 measured worse
+MAX_ROUNDS = 50  # mode changes per step, then move on (docs/experiments/Sweeper-v1.md)
+PARTICLE_VOTES = EVIDENCE  # per particle's map (fastslam.py; other values: the same file)
 
 
 def robot_geometry(observation_space: spaces.Space, env_kwargs: dict[str, Any]) -> tuple[int, int]:

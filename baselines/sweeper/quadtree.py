@@ -24,8 +24,8 @@ those, one that sweeps the most cells not yet swept on its way
 that passes along a leftover strip sweeps it. Without gains the cells
 follow the chain square by square with L-shaped moves. :func:`bfs_plan`,
 the shortest path over all known free configurations with the quadtree only
-deciding that one exists, is kept as the ablation (the policy's transfers
-before issue 17); docs/experiments/Sweeper-v1.md compares their travel.
+deciding that one exists, is kept as the ablation (the policy's earlier
+transfers); docs/experiments/Sweeper-v1.md compares their travel.
 """
 
 from __future__ import annotations

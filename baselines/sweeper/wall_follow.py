@@ -15,9 +15,9 @@ Our reading:
   when a wall or an obstacle stops it. Taken literally ("move until the
   wall, then look"), a robot in an empty rectangle goes from corner to
   corner along the walls for ever once a leg has ended in a corner, and
-  sweeps only the ring it swept while following the walls (about 35 % of
-  our empty room); looking at every robot width is the coarsest rule that
-  leaves the ring.
+  sweeps only the ring it swept while following the walls; looking at
+  every robot width is the coarsest rule that leaves the ring
+  (docs/experiments/Sweeper-v0.md).
 - "Least swept direction": for each heading, the straight run ahead up to
   the first known obstacle (unknown cells count as free); its sweep fraction
   is the share of swept cells in the footprints along it. The run with the

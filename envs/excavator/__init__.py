@@ -1,7 +1,7 @@
 """The excavator world: a 20 t backhoe, carving ground, a buried pipe and a truck.
 
-Paper: ``../shared/papers/002_884a424d690ac408.txt`` (kinematics eq. 1-5,
-Newton-Raphson IK eq. 9-13); our reading: ``../shared/specs/excavator.md``.
+Paper: Shin, Park, Lee and Hong, "Development of Optimal Path Planning for
+Automated Excavator" (kinematics eq. 1-5, Newton-Raphson IK eq. 9-13).
 ``motiongym/ExcavatorReachGoal-v1``: ``ExcavatorReach-v1`` as a
 goal-conditioned environment (HER), see :mod:`motiongym.envs.goal` and
 :mod:`.goal`.

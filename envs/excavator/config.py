@@ -1,7 +1,7 @@
 """One documented 20-tonne-class backhoe excavator: the paper's Table 1 filled in.
 
-The paper's link lengths are in its Fig. 3, which the text does not carry
-(``../shared/specs/excavator.md``). We use a machine of the 20 t class, the
+The paper's link lengths are in its Fig. 3, which the text does not carry.
+We use a machine of the 20 t class, the
 most common crawler excavator, with numbers rounded from public spec sheets
 of that class (Caterpillar 320 / Komatsu PC210 / Volvo EC220 brochures):
 

@@ -1,7 +1,8 @@
 """The excavator environments: reach a bucket pose, and one full dig cycle.
 
-Both wire a world (:class:`.world.ExcavatorWorld`, physics "v0", or
-:class:`.world_v1.ExcavatorWorldV1`, physics "v1") to a task
+Each is a :class:`motiongym.envs.core.SystemEnv`: a world
+(:class:`.world.ExcavatorWorld`, physics "v0", or
+:class:`.world_v1.ExcavatorWorldV1`, physics "v1") and a task
 (:mod:`.task`); the parameters are :mod:`.params`, the observation layout
 :mod:`.observation`.
 """
@@ -9,41 +10,27 @@ Both wire a world (:class:`.world.ExcavatorWorld`, physics "v0", or
 from __future__ import annotations
 
 import math
-import struct
-from functools import partial
-from typing import Any
+from typing import Any, ClassVar
 
-import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
 
 from motiongym.envs.actions import checked_box_action
-from motiongym.envs.core import (
-    ArgumentError,
-    NeedsReset,
-    add_reward_terms,
-    check_options,
-    check_render_mode,
-    check_shape,
-    zero_terms,
-)
-from motiongym.envs.excavator import observation as obs_layout
-from motiongym.envs.excavator.params import params_for
-from motiongym.envs.excavator.task import DigTask, ReachTask
+from motiongym.envs.core import ArgumentError, SystemEnv
+from motiongym.envs.excavator.config import Machine
+from motiongym.envs.excavator.params import DigParams, ExcavatorParams, ReachParams
+from motiongym.envs.excavator.task import DigTask, ExcavatorTask, ReachTask
 from motiongym.envs.excavator.world import ExcavatorWorld
-from motiongym.envs.rendering import Renders
-
-# Observation fields q ... fill written as float32 straight into the buffer: the
-# same rounding as NumPy's cast, without converting a list.
-_STATE = struct.Struct("=13f")
+from motiongym.envs.layout import ObservationLayout
 
 _COMMON_INFO = """
     Keyword arguments (:mod:`motiongym.envs.excavator.params`, every one
     checked at construction, limits in its table): ``machine`` (dict of
     :class:`Machine` overrides), ``dt`` (s), ``pipe_safety`` (m),
     ``physics`` ("v0" or "v1"), ``slope`` (rad, v1), the task's tolerances,
-    the reward weights, ``render_mode`` ("rgb_array", or "human": a window,
-    see :mod:`motiongym.envs.rendering`), ``render_size`` (rows, columns).
+    the reward weights (magnitudes in [0, 1e6]: a cost term is subtracted),
+    ``render_mode`` ("rgb_array", or "human": a window, see
+    :mod:`motiongym.envs.rendering`), ``render_size`` (rows, columns of a
+    frame, each in [16, 2048]; default (480, 640)).
 
     ``info`` (every step and reset): ``is_success``; ``cost`` (1.0 on a step
     where the pipe clearance is below ``pipe_safety``, 0.5 m by default: the
@@ -64,113 +51,10 @@ _COMMON_INFO = """
     non-finite entry is a ``ValueError``. ``step()`` / ``render()`` before
     ``reset()``: ``RuntimeError``.
 
-    Reset options: ``q0`` (4 finite joint angles, rad, clipped to the joint
-    ranges) instead of the ready pose ``Machine.q_ready`` (bucket curled, 2 m up).
+    Reset options: ``start`` (4 finite joint angles, rad, clipped to the
+    joint ranges) instead of the ready pose ``Machine.q_ready`` (bucket
+    curled, 2 m up); ``q0`` is its deprecated name (warns once).
 """
-
-
-class ExcavatorBase(NeedsReset, Renders, gym.Env):
-    """Shared wiring; see :class:`ExcavatorReachEnv` and :class:`ExcavatorEnv`."""
-
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
-    TASK: Any = ReachTask  # a task class of task.py (NAME, CARVE, REWARD_TERMS, ...)
-
-    def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
-        self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
-        self.params = params_for(self.TASK.NAME, kwargs)
-        p = self.params
-        self.m = p.machine
-        self.dt = p.dt
-        self.render_size = p.render_size
-        self.layout = obs_layout.observation_layout(self.TASK.NAME, p.physics)
-        assert self.layout["q"].start == 0 and self.layout["fill"].stop == 13
-        low, high = obs_layout.bounds(self.TASK.NAME, self.m, p.physics)
-        self.observation_space: spaces.Box = spaces.Box(low, high, dtype=np.float32)
-        self.action_space: spaces.Box = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
-        self.world = self._make_world()
-        self.task = self.TASK(p, self.layout)
-        self._profile = self.layout["profile"]
-        self._options = {"q0": partial(_check_q0)}
-        self._renderer = None
-
-    def _make_world(self):
-        if self.params.physics == "v1":
-            from motiongym.envs.excavator.world_v1 import ExcavatorWorldV1
-
-            return ExcavatorWorldV1(self.params, carve=self.TASK.CARVE)
-        return ExcavatorWorld(self.params, carve=self.TASK.CARVE)
-
-    @property
-    def scene(self):
-        """The episode's scene (:class:`.scenes.Scene`); None before the first reset."""
-        return self.world.scene
-
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        options = check_options(options, self._options)
-        super().reset(seed=seed)
-        scene = self.task.sample_scene(self.np_random)
-        self.world.reset(scene, options.get("q0", self.m.q_ready))
-        self._obs = np.zeros(self.observation_space.shape, dtype=np.float32)
-        self._obs[self.layout["truck"]] = scene.truck.as_array()
-        self._obs[self.layout["pipe"]] = scene.pipe.as_array()
-        if "base" in self.layout:
-            self._obs[self.layout["base"]] = scene.base[:2]
-        self.task.reset(self.world, self._obs)
-        self._was_reset = True
-        _, info = self._reward_and_info(zero_terms(self.TASK.REWARD_TERMS), False)
-        self._show_if_human()
-        return self._observation(), info
-
-    def step(self, action):
-        self._require_reset("step")
-        values = _checked_action(action)
-        world = self.world
-        world.advance(values)
-        terms, success = self.task.step(world)
-        reward, info = self._reward_and_info(terms, success)
-        terminated = bool(success or world.contact)
-        self._show_if_human()
-        return self._observation(), reward, terminated, False, info
-
-    def _observation(self) -> np.ndarray:
-        """The layout of :mod:`.observation`; inside the bounds by construction (tested).
-
-        The static fields (task, truck, pipe, base) are written once at reset.
-        """
-        w, buf = self.world, self._obs
-        # numpy declares the buffer protocol (__buffer__) to type checkers for Python >= 3.12 only
-        _STATE.pack_into(buf, 0, *w.q, *w.qdot, *w.tip, w.beta, w.fill)  # type: ignore[arg-type]
-        buf[self._profile] = w.profile()
-        self.task.write(w, buf)
-        return buf.copy()
-
-    def _reward_and_info(self, terms: dict[str, float], success: bool):
-        """The reward and ``info`` in the layout of :func:`reward_and_info`, built in one go."""
-        w = self.world
-        pipe, truck = w.pipe_clear, w.truck_clear
-        info: dict[str, Any] = {
-            "is_success": bool(success),
-            "cost": 1.0 if pipe < self.params.pipe_safety or w.contact else 0.0,
-            "pipe_clearance": float(pipe),
-            "truck_clearance": float(truck),
-            "pipe_contact": 1.0 if pipe <= 0.0 else 0.0,
-            "truck_contact": 1.0 if truck <= 0.0 else 0.0,
-            "bucket_fill": float(w.fill),
-            "truck_soil": float(w.truck_soil),
-            "spill": float(w.spill),
-            "elapsed": float(w.elapsed),
-        }
-        info.update(w.measures())
-        info.update(self.task.measures(w))
-        return add_reward_terms(info, terms), info
-
-    def _frame(self) -> np.ndarray:
-        if self._renderer is None:
-            from motiongym.envs.excavator.render_scene import SceneRenderer
-
-            self._renderer = SceneRenderer(self.m, self.render_size)
-        return self._renderer.render(self.world)
-
 
 _FLOAT32 = np.dtype(np.float32)
 _ACTION_SPACE = "Box(-1.0, 1.0, (4,), float32): swing, boom, stick, bucket rates"
@@ -189,8 +73,43 @@ def _checked_action(action: Any) -> list[float]:
     return checked_box_action(action, (4,), _ACTION_SPACE).tolist()
 
 
-def _check_q0(name: str, value: Any) -> np.ndarray:
-    return check_shape(name, value, (4,))
+class ExcavatorBase(SystemEnv):
+    """Shared wiring; see :class:`ExcavatorReachEnv` and :class:`ExcavatorEnv`."""
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+    Params: ClassVar[type[ExcavatorParams]] = ReachParams
+    TASK: ClassVar[type[ExcavatorTask]] = ReachTask
+    ACTION_MEANING = _ACTION_SPACE
+    params: ExcavatorParams
+    world: ExcavatorWorld
+    task: ExcavatorTask
+    # The fast check of an action (no call through the base's generic one).
+    check_action = staticmethod(_checked_action)
+
+    def make_world(self, params: ExcavatorParams) -> ExcavatorWorld:
+        if params.physics == "v1":
+            from motiongym.envs.excavator.world_v1 import ExcavatorWorldV1
+
+            return ExcavatorWorldV1(params, carve=self.TASK.CARVE)
+        return ExcavatorWorld(params, carve=self.TASK.CARVE)
+
+    def make_task(self, params: ExcavatorParams) -> ExcavatorTask:
+        return self.TASK(params)
+
+    @property
+    def m(self) -> Machine:
+        """The machine (``params.machine``)."""
+        return self.params.machine
+
+    @property
+    def dt(self) -> float:
+        """The control period (s)."""
+        return self.params.dt
+
+    @property
+    def layout(self) -> ObservationLayout:
+        """The observation's layout (:func:`.observation.observation_layout`)."""
+        return self.task.layout
 
 
 class ExcavatorReachEnv(ExcavatorBase):
@@ -237,6 +156,7 @@ class ExcavatorReachEnv(ExcavatorBase):
     """
     )
 
+    Params = ReachParams
     TASK = ReachTask
     metadata = {
         **ExcavatorBase.metadata,
@@ -313,6 +233,7 @@ class ExcavatorEnv(ExcavatorBase):
     """
     )
 
+    Params = DigParams
     TASK = DigTask
     metadata = {
         **ExcavatorBase.metadata,
@@ -341,6 +262,8 @@ class ExcavatorEnv(ExcavatorBase):
             "elapsed": "s",
         },
     }
+
+    task: DigTask
 
     def subgoal(self) -> tuple[float, float, float]:
         """:meth:`DigTask.subgoal` of the current state."""

@@ -16,11 +16,16 @@ pipe_safety         finite, in [0, 5] m
 physics             "v0" (registered v0 IDs) or "v1" (see :mod:`.world`)
 slope               finite, in [0, 0.3] rad: the largest base roll / pitch a
                     scene draws (v1 only; 0 is level ground)
-render_size         (rows, columns), integers in [16, 2048]
+render_size         (rows, columns) of a frame, integers in [16, 2048]
+                    (:func:`motiongym.envs.core.check_render_size`)
 tolerances          finite, in (0, 10] (m or rad)
 closeness_scale     finite, in (0, 100] m
 success_volume      finite, in (0, 50] m3
-reward weights      finite, in [-1e6, 1e6]
+reward weights      magnitudes, finite, in [0, 1e6]
+                    (:func:`motiongym.envs.core.check_weight`); a term's sign is
+                    its meaning's (a cost is subtracted), so a negative weight is
+                    refused (for a cost: naming the positive weight of the same
+                    reward)
 ==================  ==========================================================
 """
 
@@ -33,12 +38,11 @@ from motiongym.envs.core import (
     ArgumentError,
     check_choice,
     check_float,
-    check_int,
+    check_render_size,
+    check_weight,
     params_from_kwargs,
 )
 from motiongym.envs.excavator.config import Machine, machine_from_kwargs
-
-WEIGHT_LIMIT = 1e6
 
 
 @dataclass(frozen=True)
@@ -50,9 +54,10 @@ class ExcavatorParams:
     pipe_safety: float = 0.5  # m
     physics: str = "v0"
     slope: float = 0.0  # rad
-    render_size: tuple[int, int] = (480, 640)
+    render_size: tuple[int, int] = (480, 640)  # rows, columns of a frame
 
     REWARD_TERMS: ClassVar[tuple[str, ...]] = ()
+    COSTS: ClassVar[tuple[str, ...]] = ()  # the terms that are subtracted
 
     def __post_init__(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
@@ -63,12 +68,9 @@ class ExcavatorParams:
         put("slope", check_float("slope", self.slope, 0.0, 0.3))
         if self.physics == "v0" and self.slope != 0.0:
             raise ArgumentError(f"slope must be 0 with physics 'v0', got {self.slope!r}")
-        size = self.render_size
-        if not isinstance(size, (tuple, list)) or len(size) != 2:
-            raise ArgumentError(f"render_size must be (rows, columns), got {size!r}")
-        put("render_size", tuple(check_int("render_size", v, 16, 2048) for v in size))
+        put("render_size", check_render_size("render_size", self.render_size))
         for name in self.REWARD_TERMS:
-            put(name, check_float(name, getattr(self, name), -WEIGHT_LIMIT, WEIGHT_LIMIT))
+            put(name, check_weight(name, getattr(self, name), cost=name in self.COSTS))
 
     @property
     def m(self) -> Machine:
@@ -95,6 +97,7 @@ class ReachParams(ExcavatorParams):
     closeness_scale: float = 0.5  # m (and rad, 1 m per rad)
 
     REWARD_TERMS = ("progress", "clearance", "contact", "time", "success", "closeness")
+    COSTS = ("clearance", "contact", "time")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -131,6 +134,7 @@ class DigParams(ExcavatorParams):
         "success",
         "approach",
     )
+    COSTS = ("spill", "clearance", "contact", "time")
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -126,12 +126,22 @@ def build_model(m: Machine, with_world: bool = True) -> mujoco.MjModel:
 
 
 class SceneRenderer:
-    """Offscreen rendering of an excavator environment (``MUJOCO_GL=egl``)."""
+    """Offscreen rendering of an excavator world (``MUJOCO_GL=egl``) at ``size`` =
+    (rows, columns).
+
+    The model's offscreen buffer (``vis.global_.offheight`` / ``offwidth``,
+    640 x 480 by default) is enlarged to ``size`` where that is larger, so
+    every size :func:`motiongym.envs.core.check_render_size` allows renders.
+    """
 
     def __init__(self, m: Machine, size: tuple[int, int]) -> None:
+        self.size = (int(size[0]), int(size[1]))
         self.model = build_model(m)
+        buffer = self.model.vis.global_
+        buffer.offheight = max(buffer.offheight, self.size[0])
+        buffer.offwidth = max(buffer.offwidth, self.size[1])
         self.data = mujoco.MjData(self.model)
-        self.renderer = mujoco.Renderer(self.model, height=size[0], width=size[1])
+        self.renderer = mujoco.Renderer(self.model, height=self.size[0], width=self.size[1])
         self.camera = mujoco.MjvCamera()
         self.camera.lookat[:] = [3.0, 0.0, 0.5]
         self.camera.distance, self.camera.elevation, self.camera.azimuth = 24.0, -28.0, -130.0

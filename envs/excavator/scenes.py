@@ -89,6 +89,8 @@ class Scene:
     zone: DigZone | None = None
     target: np.ndarray | None = None  # (4,) tip x, y, z (m) and bucket angle (rad)
     base: tuple[float, float, float] = (0.0, 0.0, 0.0)  # roll, pitch, yaw (rad): H_M^O
+    # (4,) joint angles at reset (rad, clipped to the joint ranges); None: Machine.q_ready
+    start: np.ndarray | tuple[float, ...] | None = None
 
 
 def sample_base(rng: np.random.Generator, slope: float) -> tuple[float, float, float]:
@@ -243,7 +245,7 @@ def sample_reach_scene(rng: np.random.Generator, m: Machine, slope: float = 0.0)
         if truck_clearance(pts, m.link_radius, truck) < 1.0:
             continue
         break
-    else:  # pragma: no cover - the acceptance rate is about 5 %
+    else:  # pragma: no cover - no candidate of 10,000 accepted
         raise RuntimeError("could not sample a reachable target")
     azimuth = math.atan2(tip[1], tip[0])
     r_tip = math.hypot(tip[0], tip[1])

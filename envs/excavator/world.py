@@ -1,15 +1,22 @@
 """The excavator world: the machine's state and dynamics on carving ground.
 
 :class:`ExcavatorWorld` is the only code that changes the machine, the
-terrain and the soil accounts; the tasks (:mod:`.task`) read it, the
-environments (:mod:`.env`) wire the two. API::
+terrain and the soil accounts (a :class:`motiongym.envs.core.World`); the
+tasks (:mod:`.task`) read it, the environments (:mod:`.env`) wire the two.
+API::
 
     world = ExcavatorWorld(params, carve=True)
-    world.reset(scene, q0)          # a scene of .scenes, 4 joint angles
-    world.advance([a1, a2, a3, a4]) # one step of dt s, actions in [-1, 1]
+    world.action_space              # Box(-1, 1, (4,), float32)
+    world.reset(scene, rng)         # a scene of .scenes; the machine at scene.start
+    world.advance([a1, a2, a3, a4]) # one step of dt s, actions clipped to [-1, 1]; -> None
+    world.render((rows, columns))   # an RGB frame (.render_scene)
     world.q, world.qdot, world.tip, world.beta, world.fill, world.truck_soil,
     world.spill, world.pipe_clear, world.truck_clear, world.contact,
     world.taken (m3 cut this step), world.terrain, world.profile()
+
+``advance`` returns no events: what happened in the step is the state it
+leaves (``contact``, ``taken``, the clearances, the soil accounts). The
+world draws no noise (``reset``'s ``rng`` is not used).
 
 Physics "v0" (the v0 IDs), one step:
 
@@ -32,8 +39,7 @@ it (nothing stops an agent). The base stands level at the origin
 (``H_M^O`` = identity): frame M is the world frame. Physics "v1" is
 :class:`motiongym.envs.excavator.world_v1.ExcavatorWorldV1`.
 
-The scalar state lives in Python floats: the step makes few NumPy calls
-(a step costs tens of microseconds).
+The scalar state lives in Python floats: the step makes few NumPy calls.
 """
 
 from __future__ import annotations
@@ -42,6 +48,7 @@ import functools
 import math
 
 import numpy as np
+from gymnasium import spaces
 
 from motiongym.envs.excavator.config import Machine
 from motiongym.envs.excavator.kinematics import arm_points
@@ -50,6 +57,7 @@ from motiongym.envs.excavator.obstacles import Pipe, Truck, pipe_clearance, truc
 from motiongym.envs.excavator.params import ExcavatorParams
 from motiongym.envs.excavator.scenes import GRID_CELL, GRID_ORIGIN, GRID_SHAPE, Scene
 from motiongym.envs.excavator.soil import Terrain, speed_fraction
+from motiongym.envs.rendering import OwnsRenderer
 
 POUR_NZ = -0.3  # opening normal z below which soil pours
 POUR_TIME = 1.0  # s to empty a full bucket
@@ -74,7 +82,7 @@ def profile_table(L0: float, d2: float) -> np.ndarray:
     return i * GRID_SHAPE[1] + j
 
 
-class ExcavatorWorld:
+class ExcavatorWorld(OwnsRenderer):
     """The machine, the ground, the pipe and the truck (see the module docstring)."""
 
     def __init__(self, params: ExcavatorParams, carve: bool) -> None:
@@ -84,15 +92,18 @@ class ExcavatorWorld:
         self.carve = carve
         m = self.m
         self._joints = tuple(zip(range(4), m.rate_max, m.q_min, m.q_max, strict=True))
+        self.action_space: spaces.Space = spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float32)
         self.scene: Scene | None = None
 
     # ----------------------------------------------------------------- reset
-    def reset(self, scene: Scene, q0) -> None:
-        """Place the scene and the machine at joint angles ``q0`` (clipped to the ranges)."""
+    def reset(self, scene: Scene, rng: np.random.Generator | None = None) -> None:
+        """Place the scene and the machine at ``scene.start`` (4 joint angles, clipped to
+        the ranges; None: ``Machine.q_ready``)."""
         self.scene = scene
         self.terrain = Terrain(scene.heights, GRID_ORIGIN, GRID_CELL)
         self.pipe: Pipe = scene.pipe
         self.truck: Truck = scene.truck
+        q0 = self.m.q_ready if scene.start is None else scene.start
         self.q = np.clip(np.asarray(q0, dtype=np.float64), self.m.q_min, self.m.q_max).tolist()
         self.qdot = [0.0, 0.0, 0.0, 0.0]
         self.fill = 0.0
@@ -121,7 +132,10 @@ class ExcavatorWorld:
 
     # ------------------------------------------------------------------ step
     def advance(self, values: list[float]) -> None:
-        """One step of ``dt`` s under the actions ``values`` (4 floats, clipped to [-1, 1])."""
+        """One step of ``dt`` s under the actions ``values`` (4 floats, clipped to [-1, 1]).
+
+        No events are returned: the step's are the state it leaves (module docstring).
+        """
         m, dt = self.m, self.dt
         scale = 1.0
         if self.carve:
@@ -148,6 +162,17 @@ class ExcavatorWorld:
     def measures(self) -> dict[str, float]:
         """Extra ``info`` keys of this physics (none in v0)."""
         return {}
+
+    def render(self, size: tuple[int, int]) -> np.ndarray:
+        """An RGB frame of ``size`` = (rows, columns) (:class:`.render_scene.SceneRenderer`,
+        made on the first call and again when the size changes)."""
+        renderer = self._renderer
+        if renderer is None or renderer.size != tuple(size):
+            from motiongym.envs.excavator.render_scene import SceneRenderer
+
+            self.close()
+            self._renderer = renderer = SceneRenderer(self.m, size)
+        return renderer.render(self)
 
     @property
     def contact(self) -> bool:

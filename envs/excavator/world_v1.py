@@ -1,7 +1,8 @@
 """Physics v1 of the excavator world: a machine that cannot pass through soil, pipe or itself.
 
 :class:`ExcavatorWorldV1` has the API of :class:`.world.ExcavatorWorld`
-(``reset(scene, q0)``, ``advance(actions)``, the same state attributes) and
+(``reset(scene, rng)``, ``advance(actions)``, ``render(size)``, the same
+state attributes) and
 adds ``self_clear`` (m), ``ground_contact``, ``cut_force`` (N),
 ``advance_fraction``, ``pushed`` (m3 bank pushed by a full bucket this
 step), ``rotation`` (the base's ``R``, None when level) and
@@ -175,7 +176,7 @@ class Pose:
 class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
     """See the module docstring."""
 
-    def reset(self, scene, q0) -> None:
+    def reset(self, scene, rng=None) -> None:
         base = tuple(scene.base)
         self.rotation = None if base == (0.0, 0.0, 0.0) else base_rotation(*base).tolist()
         # R's rows flat (empty on level ground, where nothing is turned)
@@ -191,7 +192,7 @@ class ExcavatorWorldV1(ClearancesV1, ExcavatorWorld):
         self.pushed = 0.0
         self._obstacle_bounds(scene)
         self._ground_and_body_bounds(scene, base)
-        super().reset(scene, q0)
+        super().reset(scene, rng)
 
     def _obstacle_bounds(self, scene) -> None:
         """The pipe's and the truck's bodies and the constants of their bounds."""

@@ -4,29 +4,18 @@ from __future__ import annotations
 
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
 
-from motiongym.envs.core import (
-    ArgumentError,
-    NeedsReset,
-    check_render_mode,
-    reward_and_info,
-    zero_terms,
-)
-from motiongym.envs.rendering import Renders
-from motiongym.envs.sweeper import maps, task
-from motiongym.envs.sweeper.measures import measures
+from motiongym.envs.core import ArgumentError, SystemEnv
 from motiongym.envs.sweeper.params import SweeperParams
-from motiongym.envs.sweeper.render import draw
 from motiongym.envs.sweeper.state import SweeperState
+from motiongym.envs.sweeper.task import Scenario, SweeperTask
 from motiongym.envs.sweeper.world import FORWARD, LEFT, RIGHT, World
 
 __all__ = ["FORWARD", "LEFT", "RIGHT", "SweeperEnv"]
 
 
-class SweeperEnv(NeedsReset, Renders, gym.Env):
+class SweeperEnv(SystemEnv):
     """Sweep every reachable free cell of an unknown closed area (Park & Lee 1998).
 
     The world is an occupancy bitmap (paper 4.1). The robot is a square of
@@ -93,12 +82,15 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
     ## Reward
     Three named terms, summed; each is in ``info`` as ``reward_<term>``:
 
-    - ``sweep``: ``sweep * (newly swept reachable cells) / w`` (+1 for
+    - ``sweep``: ``+sweep * (newly swept reachable cells) / w`` (+1 for
       a forward move onto fresh floor, by default)
-    - ``time``: ``time`` on every step (a step cost, negative)
-    - ``bump``: ``bump`` on a bump (negative)
+    - ``time``: ``-time`` on every step (a step cost; -0.05 by default)
+    - ``bump``: ``-bump`` on a bump (-1 by default)
 
-    Each term's weight is the keyword argument of the same name.
+    Each term's weight is the keyword argument of the same name, a
+    magnitude in [0, 1e6]: a cost is subtracted, and a negative weight is
+    refused (for ``time`` and ``bump`` the message names the positive weight
+    of the same reward).
 
     ## Termination and truncation
     Terminated when every reachable free cell (the union of footprints over
@@ -136,6 +128,15 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
     configuration); ``heading``: integer 0..3. Either may be None (drawn).
     Anything else (another key, a non-dict ``options``) is a ValueError.
 
+    ## Rendering
+    ``render()`` (``render_mode="rgb_array"``) returns the map, swept cells
+    (grey; darker: swept twice), the path, the robot and its heading. With
+    ``render_size=None`` (the default) at 8 pixels per cell, the frame as
+    large as the map; with ``render_size=(rows, columns)`` a frame of that
+    shape, the map at the largest whole number of pixels per cell that fits,
+    centred (so frames of random maps of several sizes share one shape); see
+    :mod:`motiongym.envs.sweeper.render`.
+
     ## Keyword arguments
     ``render_mode`` (None, "rgb_array", or "human": a window) and the world's parameters, each
     checked at construction (type, finiteness, range, size limits; see
@@ -146,7 +147,9 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
     ``robot_width`` (cells, 3), ``sensor_range`` (cells beyond the footprint,
     default ``robot_width``), ``coarse`` (K, 16), ``heading_noise``,
     ``slip_noise``, ``sweep``, ``time``, ``bump`` (the reward weights),
-    ``cell_pixels`` (render scale), ``line_of_sight`` (False; True in v1).
+    ``render_size`` ((rows, columns) of a frame, or None), ``cell_pixels``
+    (deprecated: pixels per cell; use ``render_size``), ``line_of_sight``
+    (False; True in v1).
 
     ## Actions, reset
     An action is what ``Discrete(3).contains`` accepts (a Python int or a
@@ -189,28 +192,35 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
         },
     }
 
-    def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
-        self.params = p = SweeperParams.from_kwargs(kwargs)
-        self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
-        self.fixed = task.resolve_map(p)  # the fixed map, or None (procedural)
-        self.world = World(p)
-        S, K = p.window, p.coarse
-        side = float(maps.MAX_SIDE)
-        window = spaces.Box(0.0, 1.0, (S * S,), np.float32)
-        coarse_map = spaces.Box(0.0, 1.0, (K * K,), np.float32)
-        keys: dict[str, spaces.Space] = {
-            "sensed": window,
-            "swept": window,
-            "pose": spaces.Box(
-                np.zeros(4, np.float32), np.array([side, side, 3.0, 1.0], np.float32)
-            ),
-            "sweep_map": coarse_map,
-            "obstacle_map": coarse_map,
-        }
-        if p.line_of_sight:
-            keys["known"] = window
-        self.observation_space = spaces.Dict(keys)
-        self.action_space = spaces.Discrete(3)
+    Params = SweeperParams
+    params: SweeperParams
+    world: World
+    task: SweeperTask
+    ACTION_MEANING = "0 forward, 1 left, 2 right: an int or a NumPy integer scalar"
+
+    def make_world(self, params: SweeperParams) -> World:
+        return World(params)
+
+    def make_task(self, params: SweeperParams) -> SweeperTask:
+        return SweeperTask(params)
+
+    def check_action(self, action: Any) -> int:
+        if type(action) is int and 0 <= action <= 2:
+            return action
+        try:
+            allowed = self.action_space.contains(action)
+        except (OverflowError, TypeError, ValueError):  # e.g. an int past int64
+            allowed = False
+        if not allowed:
+            raise ArgumentError(
+                f"action must be in {self.action_space} ({self.ACTION_MEANING}), got {action!r}"
+            )
+        return int(action)
+
+    @property
+    def fixed(self) -> np.ndarray | None:
+        """The fixed map, or None when every episode draws a procedural one."""
+        return self.task.fixed
 
     @property
     def state(self) -> SweeperState | None:
@@ -218,67 +228,10 @@ class SweeperEnv(NeedsReset, Renders, gym.Env):
         return self.world.state
 
     @property
-    def scenario(self) -> task.Scenario | None:
+    def scenario(self) -> Scenario | None:
         """This episode's map and start (None before the first reset)."""
-        return None if self.world.state is None else self.world.state.scenario
-
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[dict, dict]:
-        super().reset(seed=seed)
-        p = self.params
-        scenario = task.sample_scenario(
-            self.np_random, self.fixed, p.map_name, p.robot_width, options
-        )
-        self.world.reset(scenario)
-        self._was_reset = True
-        _, info = self._reward_and_info(zero_terms(task.REWARD_TERMS))
-        self._show_if_human()
-        return self.world.observation(), info
-
-    def step(self, action: Any) -> tuple[dict, float, bool, bool, dict]:
-        self._require_reset("step")
-        if type(action) is not int or not 0 <= action <= 2:
-            action = self._checked_action(action)
-        new = self.world.advance(action, self.np_random)
-        s = self.world.state
-        reward, info = self._reward_and_info(task.reward_terms(new, s.bump, self.params))
-        self._show_if_human()
-        return self.world.observation(), reward, info["is_success"], False, info
-
-    def _checked_action(self, action: Any) -> int:
-        try:
-            allowed = self.action_space.contains(action)
-        except (OverflowError, TypeError, ValueError):  # e.g. an int past int64
-            allowed = False
-        if not allowed:
-            raise ArgumentError(
-                f"action must be in {self.action_space} (0 forward, 1 left, 2 right: "
-                f"an int or a NumPy integer scalar), got {action!r}"
-            )
-        return int(action)
-
-    def _reward_and_info(self, terms: dict[str, float]) -> tuple[float, dict]:
-        s = self.world.state
-        return reward_and_info(
-            terms,
-            cost=1.0 if s.bump else 0.0,
-            is_success=task.is_success(s.n_swept, s.n_reachable),
-            **measures(
-                s.n_swept,
-                s.n_reachable,
-                s.n_overswept,
-                s.travel,
-                s.turns,
-                s.bumps,
-                s.steps,
-                self.params.robot_width,
-            ),
-        )
+        return self.world.scene
 
     def action_masks(self) -> np.ndarray:
         """(3,) bool: which actions are allowed (see "Action masks" above)."""
         return self.world.action_masks()
-
-    def _frame(self) -> np.ndarray:
-        return draw(self.world.state, self.params.robot_width, self.params.cell_pixels)

@@ -1,17 +1,21 @@
-"""The sweeper's measures in ``info``, for one world or a batch.
+"""The sweeper's reward, success and measures in ``info``, for one world or a batch.
 
-Shared by :class:`~motiongym.envs.sweeper.env.SweeperEnv` (Python scalars)
-and its NumPy-batched twin (arrays over sub-environments), so that both
+Shared by :class:`~motiongym.envs.sweeper.task.SweeperTask` (Python
+scalars, the single environment) and the NumPy-batched twin (arrays over
+sub-environments, :mod:`motiongym.envs.sweeper.vector_env`), so that both
 compute every number from the same formulas.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from motiongym.envs.sweeper.task import REWARD_TERMS
+if TYPE_CHECKING:  # pragma: no cover
+    from motiongym.envs.sweeper.params import SweeperParams
+
+REWARD_TERMS = ("sweep", "time", "bump")
 
 INFO_KEYS = (
     "is_success",
@@ -25,6 +29,28 @@ INFO_KEYS = (
     "steps",
     *(f"reward_{term}" for term in REWARD_TERMS),
 )
+
+
+def is_success(n_swept: Any, n_reachable: Any) -> Any:
+    """Every reachable cell swept (for one world or a batch)."""
+    return n_swept >= n_reachable
+
+
+def reward_terms(new_cells: Any, bump: Any, params: SweeperParams) -> dict[str, Any]:
+    """The reward's terms, for one world (scalars) or a batch (arrays).
+
+    - ``sweep``: ``+params.sweep`` per fresh lane cell (newly swept reachable
+      cells over the robot width ``w``);
+    - ``time``: ``-params.time`` on every step (a cost);
+    - ``bump``: ``-params.bump`` on a bump (a cost).
+    """
+    cost = -params.bump
+    bumped = np.where(bump, cost, 0.0) if isinstance(bump, np.ndarray) else (cost if bump else 0.0)
+    return {
+        "sweep": params.sweep * new_cells / params.robot_width,
+        "time": -params.time,
+        "bump": bumped,
+    }
 
 
 def measures(

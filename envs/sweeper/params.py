@@ -11,15 +11,18 @@ from __future__ import annotations
 import dataclasses
 import os
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, ClassVar
 
 from motiongym.envs.core import (
     ArgumentError,
+    Deprecated,
     check_bool,
     check_choice,
     check_float,
     check_int,
+    check_render_size,
     check_shape,
+    check_weight,
     params_from_kwargs,
 )
 from motiongym.envs.sweeper import generator, maps
@@ -28,9 +31,8 @@ MAP_CHOICES = (*maps.SHIPPED_MAPS, "random", *(f"random-{k}" for k in generator.
 MAX_ROBOT_WIDTH = 10  # cells
 MAX_SENSOR_RANGE = 16  # cells beyond the footprint
 MAX_COARSE = 64  # K: the coarse maps hold K * K numbers each
-MAX_CELL_PIXELS = 32  # pixels per cell in a rendered frame (a 256-cell side: 8,192 pixels)
+MAX_CELL_PIXELS = 32  # deprecated cell_pixels: pixels per cell (a 256-cell side: 8,192 pixels)
 MAX_NOISE = 1.0  # rad per action (heading), relative std (slip)
-MAX_WEIGHT = 1e6  # largest magnitude of a reward weight
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -53,19 +55,32 @@ class SweeperParams:
     coarse         16        K, integer in [1, 64] (coarse maps of K * K)
     heading_noise  0.0       rad std per action, finite in [0, 1]
     slip_noise     0.0       relative std of a move's length, finite in [0, 1]
-    sweep          1.0       weight of the ``sweep`` reward term, finite,
-                             magnitude at most 1e6 (so are the next two)
-    time           -0.05     the ``time`` term (a step cost)
-    bump           -1.0      the ``bump`` term
-    cell_pixels    8         render scale, integer in [1, 32]
+    sweep          1.0       weight of the ``sweep`` reward term (paid per
+                             fresh lane cell); a reward weight is a magnitude,
+                             finite in [0, 1e6] (so are the next two)
+    time           0.05      weight of the ``time`` term, a cost: subtracted
+                             on every step
+    bump           1.0       weight of the ``bump`` term, a cost: subtracted
+                             on a bump
+    render_size    None      (rows, columns) of a frame, integers in
+                             [16, 2048]; None: 8 pixels per cell, the frame
+                             as large as the map
+    cell_pixels    None      deprecated (use ``render_size``): pixels per
+                             cell, integer in [1, 32]; not with ``render_size``
     line_of_sight  False     True or False (True: ``Sweeper-v1``)
     ============== ========= ===================================================
+
+    A negative reward weight is refused, never flipped (a silent flip would
+    turn a cost into a reward); for ``time`` and ``bump`` the message names
+    the positive weight of the same reward
+    (:func:`motiongym.envs.core.check_weight`).
 
     Maps are at most 256 cells a side (:data:`maps.MAX_SIDE`), checked when
     the map is loaded. So the sensing window has at most ``S = 10 + 2 * 16 =
     42`` cells a side, a step touches at most ``S^2`` cells (and, with line
     of sight, a product over at most 2.36 M line entries, built once), and a
-    frame has at most ``8,192^2`` pixels.
+    frame has at most ``8,192^2`` pixels (``cell_pixels`` = 32), else at
+    most ``2,048^2``.
     """
 
     map_name: str = "room"
@@ -78,10 +93,15 @@ class SweeperParams:
     heading_noise: float = 0.0  # rad, std per action
     slip_noise: float = 0.0  # relative std of a forward move's length
     sweep: float = 1.0  # per fresh lane cell
-    time: float = -0.05  # per step
-    bump: float = -1.0  # per bump
-    cell_pixels: int = 8  # render scale
+    time: float = 0.05  # per step, subtracted
+    bump: float = 1.0  # per bump, subtracted
+    render_size: tuple[int, int] | None = None  # rows, columns; None: 8 pixels per cell
+    cell_pixels: int | None = None  # deprecated: pixels per cell
     line_of_sight: bool = False  # v1's sensing
+
+    DEPRECATED: ClassVar[dict[str, Deprecated]] = {
+        "cell_pixels": Deprecated(None, note="use render_size=(rows, columns)"),
+    }
 
     def __post_init__(self) -> None:
         check_choice("map_name", self.map_name, MAP_CHOICES)
@@ -99,8 +119,17 @@ class SweeperParams:
         for name in ("heading_noise", "slip_noise"):
             set_(self, name, check_float(name, getattr(self, name), 0.0, MAX_NOISE))
         for name in ("sweep", "time", "bump"):
-            set_(self, name, check_float(name, getattr(self, name), -MAX_WEIGHT, MAX_WEIGHT))
-        set_(self, "cell_pixels", check_int("cell_pixels", self.cell_pixels, 1, MAX_CELL_PIXELS))
+            set_(self, name, check_weight(name, getattr(self, name), cost=name != "sweep"))
+        if self.render_size is not None:
+            set_(self, "render_size", check_render_size("render_size", self.render_size))
+        if self.cell_pixels is not None:
+            px = check_int("cell_pixels", self.cell_pixels, 1, MAX_CELL_PIXELS)
+            set_(self, "cell_pixels", px)
+            if self.render_size is not None:
+                raise ArgumentError(
+                    f"give render_size or the deprecated cell_pixels, not both; got "
+                    f"render_size={self.render_size!r}, cell_pixels={px!r}"
+                )
         set_(self, "line_of_sight", check_bool("line_of_sight", self.line_of_sight))
 
     @classmethod

@@ -1,4 +1,15 @@
-"""RGB image of the sweeper world: map, swept cells, path, robot (paper Fig. 7-14 style)."""
+"""RGB image of the sweeper world: map, swept cells, path, robot (paper Fig. 7-14 style).
+
+:func:`frame` is what ``render()`` returns (the single environment and its
+vector twin): with ``render_size`` None, the map at ``cell_pixels`` (8 by
+default) pixels per cell, the frame as large as the map; with
+``render_size`` = (rows, columns), a frame of exactly that shape, the map
+drawn at the largest whole number of pixels per cell that fits and centred,
+the margin in the obstacle colour (outside the map is obstacle). A map
+larger than the frame at one pixel per cell is shrunk to fit by
+nearest-neighbour sampling. So the frames of an episode, or of random maps
+of several sizes, all have one shape.
+"""
 
 from __future__ import annotations
 
@@ -17,7 +28,32 @@ ROBOT = np.array([220, 40, 40], np.uint8)
 BELIEVED = np.array([250, 160, 0], np.uint8)
 
 
-def draw(state: SweeperState, w: int, px: int = 8) -> np.ndarray:
+CELL_PIXELS = 8  # pixels per cell without a render_size
+
+
+def frame(
+    state: SweeperState, w: int, render_size: tuple[int, int] | None, cell_pixels: int | None
+) -> np.ndarray:
+    """The rendered frame of a world's ``state`` (module docstring)."""
+    if render_size is None:
+        return draw(state, w, cell_pixels or CELL_PIXELS)
+    rows, cols = render_size
+    h, wd = state.scenario.obstacle.shape
+    px = min(rows // h, cols // wd)
+    if px >= 1:
+        img = draw(state, w, px)
+    else:
+        scale = min(rows / h, cols / wd)
+        nh, nw = max(1, int(h * scale)), max(1, int(wd * scale))
+        img = draw(state, w, 1)[(np.arange(nh) * h) // nh][:, (np.arange(nw) * wd) // nw]
+    out = np.empty((rows, cols, 3), np.uint8)
+    out[:] = OBSTACLE
+    top, left = (rows - img.shape[0]) // 2, (cols - img.shape[1]) // 2
+    out[top : top + img.shape[0], left : left + img.shape[1]] = img
+    return out
+
+
+def draw(state: SweeperState, w: int, px: int = CELL_PIXELS) -> np.ndarray:
     """``(H * px, W * px, 3)`` uint8 image of a world's ``state`` (robot width ``w``).
 
     The believed footprint is outlined too where odometry error moved it off

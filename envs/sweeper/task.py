@@ -1,25 +1,51 @@
 """The sweeper's task: which map, where the robot starts, what counts as done and paid.
 
-A scenario is drawn from the environment's ``np_random`` only: the map (a
-fixed one, or a procedural one when the map name is ``"random"``), the start
-configuration (uniform over free configurations) and the start heading
-(uniform over the four). ``reset(options=...)`` may fix the start and heading
-(:data:`OPTIONS`). Success is every reachable cell swept; the reward is three
-named terms (:func:`reward_terms`).
+:class:`SweeperTask` obeys :class:`motiongym.envs.core.Task`; it reads the
+world (:class:`~motiongym.envs.sweeper.world.World`) and never moves it.
+
+* ``sample(rng, options) -> Scenario``: drawn from the environment's
+  ``np_random`` only (:func:`sample_scenario`): the map (a fixed one, or a
+  procedural one when the map name starts with ``"random"``), the start
+  configuration (uniform over free configurations) and the start heading
+  (uniform over the four); the reset options ``start`` and ``heading``
+  (:data:`OPTIONS`) fix them;
+* ``begin(world)`` / ``evaluate(world, events)``: the reward terms of
+  :func:`~motiongym.envs.sweeper.measures.reward_terms` (``events``: the
+  cells the step newly swept), success (every reachable cell swept, which
+  also terminates), the cost (1.0 on a bump) and the measures of
+  :func:`~motiongym.envs.sweeper.measures.measures`;
+* ``observe(world)``: the ``Dict`` observation of ``SweeperEnv``'s
+  docstring (fresh arrays).
+
+The reward, success and measures are the formulas of
+:mod:`~motiongym.envs.sweeper.measures`, shared with the vector twin.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
-from motiongym.envs.core import ArgumentError, check_int, check_options
+from motiongym.envs.core import START, ArgumentError, Outcome, check_int, zero_terms
 from motiongym.envs.sweeper import generator, maps, occupancy
+from motiongym.envs.sweeper.measures import REWARD_TERMS, is_success, measures, reward_terms
 from motiongym.envs.sweeper.params import SweeperParams
 
-REWARD_TERMS = ("sweep", "time", "bump")
+__all__ = [
+    "OPTIONS",
+    "REWARD_TERMS",
+    "Scenario",
+    "SweeperTask",
+    "is_success",
+    "observation_space",
+    "resolve_map",
+    "reward_terms",
+    "sample_scenario",
+]
 
 
 @dataclass
@@ -61,7 +87,7 @@ def _heading(name: str, value: Any) -> int | None:
     return None if value is None else check_int(name, value, 0, 3)
 
 
-OPTIONS = {"start": _start, "heading": _heading}  # reset option -> its check
+OPTIONS = {START: _start, "heading": _heading}  # reset option -> its check
 
 
 def sample_scenario(
@@ -69,10 +95,11 @@ def sample_scenario(
     fixed: np.ndarray | None,
     map_name: str,
     w: int,
-    options: Any,
+    options: Mapping[str, Any] | None,
 ) -> Scenario:
-    """Draw the map (if procedural), the start and the heading; apply ``options``."""
-    options = check_options(options, OPTIONS)
+    """Draw the map (if procedural), the start and the heading; apply ``options``
+    (checked by :data:`OPTIONS`; None: none)."""
+    options = options or {}
     if fixed is None:
         kind = map_name.split("-", 1)[1] if "-" in map_name else None
         obstacle = generator.random_map(rng, w, kind)
@@ -81,7 +108,7 @@ def sample_scenario(
     else:
         obstacle = fixed
     free = occupancy.config_free(obstacle, w)
-    start = options.get("start")
+    start = options.get(START)
     if start is not None:
         h, wd = obstacle.shape
         if not (start[0] < h and start[1] < wd) or not free[start]:
@@ -101,24 +128,72 @@ def sample_scenario(
     return Scenario(obstacle, free, reach_configs, reachable, start, heading)
 
 
-def is_success(n_swept: Any, n_reachable: Any) -> Any:
-    """Every reachable cell swept (for one world or a batch)."""
-    return n_swept >= n_reachable
-
-
-def reward_terms(new_cells: Any, bump: Any, params: SweeperParams) -> dict[str, Any]:
-    """The reward's terms, for one world (scalars) or a batch (arrays).
-
-    - ``sweep``: ``params.sweep`` per fresh lane cell (newly swept reachable
-      cells over the robot width ``w``);
-    - ``time``: ``params.time`` on every step;
-    - ``bump``: ``params.bump`` on a bump.
-    """
-    weight = params.bump
-    batched = isinstance(bump, np.ndarray)
-    bumped = np.where(bump, weight, 0.0) if batched else (weight if bump else 0.0)
-    return {
-        "sweep": params.sweep * new_cells / params.robot_width,
-        "time": params.time,
-        "bump": bumped,
+def observation_space(params: SweeperParams) -> spaces.Dict:
+    """The ``Dict`` observation space (``SweeperEnv``'s table)."""
+    S, K = params.window, params.coarse
+    side = float(maps.MAX_SIDE)
+    window = spaces.Box(0.0, 1.0, (S * S,), np.float32)
+    coarse_map = spaces.Box(0.0, 1.0, (K * K,), np.float32)
+    keys: dict[str, spaces.Space] = {
+        "sensed": window,
+        "swept": window,
+        "pose": spaces.Box(np.zeros(4, np.float32), np.array([side, side, 3.0, 1.0], np.float32)),
+        "sweep_map": coarse_map,
+        "obstacle_map": coarse_map,
     }
+    if params.line_of_sight:
+        keys["known"] = window
+    return spaces.Dict(keys)
+
+
+class SweeperTask:
+    """Sweep every reachable cell (module docstring); ``fixed``: the fixed map or None."""
+
+    reward_terms: tuple[str, ...] = REWARD_TERMS
+    options: Mapping[str, Callable[[str, Any], Any]] = OPTIONS
+
+    def __init__(self, params: SweeperParams) -> None:
+        self.params = params
+        self.fixed = resolve_map(params)  # the fixed map, or None (procedural)
+        self.observation_space: spaces.Space = observation_space(params)
+
+    def sample(self, rng: np.random.Generator, options: Mapping[str, Any]) -> Scenario:
+        p = self.params
+        return sample_scenario(rng, self.fixed, p.map_name, p.robot_width, options)
+
+    def begin(self, world: Any) -> Outcome:
+        return self._outcome(world.state, zero_terms(REWARD_TERMS), False)
+
+    def evaluate(self, world: Any, events: int) -> Outcome:
+        s = world.state
+        return self._outcome(s, reward_terms(events, s.bump, self.params), True)
+
+    def _outcome(self, s: Any, terms: dict[str, Any], stepped: bool) -> Outcome:
+        """The outcome of the state ``s``; a reset (not ``stepped``) never terminates."""
+        success = is_success(s.n_swept, s.n_reachable)
+        done = measures(
+            s.n_swept,
+            s.n_reachable,
+            s.n_overswept,
+            s.travel,
+            s.turns,
+            s.bumps,
+            s.steps,
+            self.params.robot_width,
+        )
+        return Outcome(terms, success, 1.0 if s.bump else 0.0, done, stepped and success)
+
+    def observe(self, world: Any) -> dict[str, np.ndarray]:
+        """The observation (see ``SweeperEnv``'s table), fresh arrays."""
+        s, S = world.state, world.S
+        br, bc = s.believed_row, s.believed_col
+        obs = {
+            "sensed": s.window.flatten(),
+            "swept": s.believed_swept[br : br + S, bc : bc + S].flatten(),
+            "pose": np.array([br, bc, s.heading, float(s.bump)], np.float32),
+            "sweep_map": (s.coarse_swept * world.inv_block).ravel(),
+            "obstacle_map": (s.coarse_obstacles * world.inv_block).ravel(),
+        }
+        if s.visible is not None:
+            obs["known"] = s.visible.flatten()
+        return obs

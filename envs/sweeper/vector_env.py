@@ -12,9 +12,16 @@ from gymnasium.vector.utils import batch_space
 from motiongym.envs.core import check_int, check_options, check_render_mode, zero_terms
 from motiongym.envs.sweeper import sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
-from motiongym.envs.sweeper.measures import INFO_KEYS, batch_info, measures
+from motiongym.envs.sweeper.measures import (
+    INFO_KEYS,
+    REWARD_TERMS,
+    batch_info,
+    is_success,
+    measures,
+    reward_terms,
+)
 from motiongym.envs.sweeper.occupancy import DC, DR
-from motiongym.envs.sweeper.render import draw
+from motiongym.envs.sweeper.render import frame
 from motiongym.envs.sweeper.state import SweeperState
 from motiongym.envs.sweeper.vector_state import (
     COUNT,
@@ -181,7 +188,7 @@ class SweeperVectorEnv(VectorEnv):
             idx = np.flatnonzero(mask)
         self._reset_envs(idx, [seeds[i] for i in idx], options or None)
         self._ready = True
-        info = self._info(idx, zero_terms(task.REWARD_TERMS), np.zeros(len(idx), bool))
+        info = self._info(idx, zero_terms(REWARD_TERMS), np.zeros(len(idx), bool))
         if mask is not None:
             info = spread_info(info, idx, N)
         self._pool.record(None)
@@ -258,9 +265,9 @@ class SweeperVectorEnv(VectorEnv):
         if ok.any():
             moved, count = self._move(fwd[ok], hf[ok], na[ok], changes)
             new[moved] = count
-        terms = task.reward_terms(new, bump, self.params)
+        terms = reward_terms(new, bump, self.params)
         reward = terms["sweep"] + terms["time"] + terms["bump"]
-        terminated = task.is_success(self.n_swept, self.n_reach)
+        terminated = is_success(self.n_swept, self.n_reach)
         truncated = self.steps >= self.max_episode_steps
         info = self._info(slice(None), terms, bump)
         self._pool.record(changes)
@@ -386,7 +393,7 @@ class SweeperVectorEnv(VectorEnv):
             final_info[key], final_info[f"_{key}"] = arr, done.copy()
         self._reset_envs(di, [None] * len(di), None)
         changes["reset"].append(di)
-        fresh = self._info(di, zero_terms(task.REWARD_TERMS), np.zeros(len(di), bool))
+        fresh = self._info(di, zero_terms(REWARD_TERMS), np.zeros(len(di), bool))
         for key in INFO_KEYS:
             info[key][di] = fresh[key]
         for key, value in self._observation(di).items():
@@ -436,7 +443,7 @@ class SweeperVectorEnv(VectorEnv):
         n_swept, n_reach, n_over, travel, turns, bumps, steps = (
             a[idx] for a in (*counters, self.bumps, self.steps)
         )
-        success = task.is_success(n_swept, n_reach)
+        success = is_success(n_swept, n_reach)
         done = measures(n_swept, n_reach, n_over, travel, turns, bumps, steps, self.w)
         info = batch_info(success, bump, terms, **done)
         mask = np.ones(len(info["coverage"]), bool)
@@ -494,5 +501,7 @@ class SweeperVectorEnv(VectorEnv):
     def render(self) -> tuple[np.ndarray, ...] | None:  # type: ignore[override]
         if self.render_mode != "rgb_array" or not self._ready:
             return None
-        px = self.params.cell_pixels
-        return tuple(draw(self.state(i), self.w, px) for i in range(self.num_envs))
+        p = self.params
+        return tuple(
+            frame(self.state(i), self.w, p.render_size, p.cell_pixels) for i in range(self.num_envs)
+        )

@@ -1,11 +1,14 @@
 """The sweeper's world: its state and dynamics, the only code that reads or writes the grid.
 
-:class:`World` holds one :class:`~motiongym.envs.sweeper.state.SweeperState`:
-``reset(scenario)`` places the robot, ``advance(action, rng)`` moves or turns
-it (sweeping and sensing), ``observation()`` and ``action_masks()`` read it.
+:class:`World` (a :class:`motiongym.envs.core.World`) holds one
+:class:`~motiongym.envs.sweeper.state.SweeperState`: ``reset(scene,
+rng)`` places the robot and keeps the episode's generator (the odometry
+noise draws from it), ``advance(action)`` moves or turns it (sweeping and
+sensing) and returns its events, the number of cells it newly swept (a
+bump is ``state.bump``); ``action_masks()`` and ``render(size)`` read it.
 The environment (:mod:`motiongym.envs.sweeper.env`) wires it to Gymnasium;
-what a scenario is and what the reward counts live in
-:mod:`motiongym.envs.sweeper.task`.
+what a scenario is, what the reward counts and what the robot observes live
+in :mod:`motiongym.envs.sweeper.task`.
 """
 
 from __future__ import annotations
@@ -13,10 +16,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from gymnasium import spaces
 
 from motiongym.envs.sweeper import occupancy, sight
 from motiongym.envs.sweeper.occupancy import DC, DR
 from motiongym.envs.sweeper.params import SweeperParams
+from motiongym.envs.sweeper.render import frame
 from motiongym.envs.sweeper.state import SweeperState
 from motiongym.envs.sweeper.task import Scenario
 
@@ -55,12 +60,25 @@ class World:
             (np.array([last]), full),
         ]
         self._rays = sight.ray_matrix(w, self.R) if params.line_of_sight else None
+        self.action_space: spaces.Space = spaces.Discrete(3)
         # None until reset() (the environment refuses a step or render before it)
         self.state: SweeperState = None  # type: ignore[assignment]
+        self._rng: np.random.Generator = None  # type: ignore[assignment]
+
+    @property
+    def scene(self) -> Scenario | None:
+        """This episode's map and start (None before the first reset)."""
+        return None if self.state is None else self.state.scenario
 
     # ------------------------------------------------------------------ reset
-    def reset(self, scenario: Scenario) -> SweeperState:
-        """Place the robot at the scenario's start; sweep its footprint; sense."""
+    def reset(self, scene: Scenario, rng: np.random.Generator) -> None:
+        """Place the robot at the scenario's start; sweep its footprint; sense.
+
+        ``rng``: the episode's generator (the environment's ``np_random``),
+        kept for the odometry noise.
+        """
+        self._rng = rng
+        scenario = scene
         h, wd = scenario.obstacle.shape
         P, K, w = self.R, self.K, self.w
         self._obstacle = np.pad(scenario.obstacle, P, constant_values=True)  # padded, bool
@@ -92,15 +110,14 @@ class World:
         s.n_swept = w * w
         self._mark_believed(np.arange(w).repeat(w) + r, np.tile(np.arange(w), w) + c)
         self._sense()
-        return s
 
     # ---------------------------------------------------------------- advance
-    def advance(self, action: int, rng: np.random.Generator) -> int:
+    def advance(self, action: int) -> int:
         """Apply ``action`` (0 forward, 1 left, 2 right); return the newly swept cells.
 
-        ``rng`` draws the odometry noise (the environment's ``np_random``).
+        The odometry noise draws from the generator given to :meth:`reset`.
         """
-        s, p = self.state, self.params
+        s, p, rng = self.state, self.params, self._rng
         s.steps += 1
         bump, new = False, 0
         if action == FORWARD:
@@ -220,21 +237,6 @@ class World:
             np.add.at(s.coarse_obstacles, (rr[inside] // bh, cc[inside] // bw), 1.0)
 
     # ---------------------------------------------------------------- readers
-    def observation(self) -> dict[str, np.ndarray]:
-        """The observation (see ``SweeperEnv``'s table), fresh arrays."""
-        s, S = self.state, self.S
-        br, bc = s.believed_row, s.believed_col
-        obs = {
-            "sensed": s.window.flatten(),
-            "swept": s.believed_swept[br : br + S, bc : bc + S].flatten(),
-            "pose": np.array([br, bc, s.heading, float(s.bump)], np.float32),
-            "sweep_map": (s.coarse_swept * self.inv_block).ravel(),
-            "obstacle_map": (s.coarse_obstacles * self.inv_block).ravel(),
-        }
-        if s.visible is not None:
-            obs["known"] = s.visible.flatten()
-        return obs
-
     def action_masks(self) -> np.ndarray:
         """(3,) bool: forward allowed unless the sensed row ahead holds an obstacle."""
         s, R, w = self.state, self.R, self.w
@@ -246,3 +248,8 @@ class World:
             win[R + w, R : R + w],  # south
         )[s.heading]
         return np.array([not ahead.any(), True, True])
+
+    def render(self, size: tuple[int, int] | None) -> np.ndarray:
+        """An RGB frame of the state: ``size`` = (rows, columns), or None for the map at
+        ``cell_pixels`` (8) pixels per cell (:func:`~motiongym.envs.sweeper.render.frame`)."""
+        return frame(self.state, self.w, size, self.params.cell_pixels)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.agents.reproduce.dual_arm_truth import at_rest_pair
 from motiongym.baselines import make_policy
 from motiongym.baselines.dual_arm import bracket, schedules

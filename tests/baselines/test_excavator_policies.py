@@ -10,7 +10,7 @@ from stable_baselines3.common.evaluation import evaluate_policy
 
 import motiongym  # noqa: F401
 from motiongym.agents.environments import resolved_env_kwargs
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.registry import make_policy

@@ -67,13 +67,13 @@ def test_policy_handles_batched_observations_and_rejects_a_wrong_arm():
 
 def _ablation(env_id, dof, seeds, **options):
     """Per-scene shortest clearance, joint-to-path distance and the plan's stall, by run_episode."""
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
     from motiongym.baselines.harvest_arm.policy import PotentialFieldPolicy
 
     kwargs = {**gym.spec(env_id).kwargs, "dof": dof, "terminate_on_collision": False}
     env = gym.make(env_id, **kwargs)
     policy = PotentialFieldPolicy(env.observation_space, env.action_space, kwargs, **options)
-    layout = env.unwrapped.layout
+    layout = env.unwrapped.task.layout
     shortest, to_path, stalled, success = [], [], [], []
     for seed in seeds:
         poses, d_min = [], [np.inf]
@@ -194,7 +194,7 @@ def test_the_markov_escape_reaches_the_fruit_where_the_plain_field_stalls():
     ESCAPE_COSINE towards the fruit): scenes 2 and 17 of HarvestArmPlanar-v0 stall without it
     and succeed with it (on 60 scenes: 93.3 % without, 96.7 % with; on the held-out seeds
     100000-100099 86 % and 97 %, docs/experiments/HarvestArmPlanar-v0.md)."""
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
 
     env_id = "motiongym/HarvestArmPlanar-v0"
     env = gym.make(env_id)
@@ -213,7 +213,7 @@ def test_critical_clearance_turns_the_field_teachers_collisions_into_no_contact(
     gripper held to its path; with the constraint relaxed below 3 cm of clearance it
     arrives without contact (on seeds 5000-5999: collisions 2.0 % -> 0 %, success 98.1 % ->
     97.1 %, docs/experiments/HarvestArm-v0.md)."""
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
 
     env_id = "motiongym/HarvestArm-v0"
     env = gym.make(env_id)

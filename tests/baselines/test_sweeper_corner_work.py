@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
-from motiongym.agents.sweeper_runs import run_sweep
+from motiongym.agents.reproduce.sweeper_runs import run_sweep
 from motiongym.baselines.sweeper.psa_cwa import PsaCwaPolicy, PsaNoCornerWorkPolicy
 from motiongym.envs.sweeper import generator
 

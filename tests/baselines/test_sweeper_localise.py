@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.baselines.sweeper.belief import RobotMap
 from motiongym.baselines.sweeper.localise import Localiser
 from motiongym.baselines.sweeper.psa_cwa import (

@@ -30,7 +30,6 @@ def _drive(error: float, target_step: tuple[int, int], steering: bool) -> tuple[
     s.row, s.col, s.y, s.x = int(r0), int(c0), float(r0), float(c0)
     s.heading, s.heading_error = 0, error
     target = (s.row + target_step[0], s.col + target_step[1])
-    rng = np.random.default_rng(0)
     for _ in range(4):  # turns first, then one forward move
         if steering:
             action = steer(
@@ -43,7 +42,7 @@ def _drive(error: float, target_step: tuple[int, int], steering: bool) -> tuple[
         else:  # the plain rule: face the target's direction, then forward
             want = DIRECTION[target_step]
             action = FORWARD if s.heading == want else (1 if (want - s.heading) % 4 == 1 else 2)
-        world.advance(action, rng)
+        world.advance(action)  # noise from the episode's generator
         if action == FORWARD:
             break
     return (s.row, s.col), target

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import motiongym  # noqa: F401
-from motiongym.agents.sweeper_runs import run_sweep, sweep
+from motiongym.agents.reproduce.sweeper_runs import run_sweep, sweep
 from motiongym.baselines.registry import make_policy
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.generator import empty_room

@@ -7,7 +7,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from motiongym import systems
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.agents.reproduce import experiments, reproduce
 from motiongym.baselines import make_policy, scripted_policies
 from motiongym.envs.registration import env_ids

@@ -18,7 +18,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 from stable_baselines3.common.env_util import make_vec_env
 from stable_baselines3.common.vec_env import SubprocVecEnv
 
-from motiongym.agents.evaluate import AGGREGATIONS, info_measures
+from motiongym.agents.evaluation.episodes import AGGREGATIONS, info_measures
 from motiongym.envs import ENV_IDS
 
 STEPS = 40

@@ -85,7 +85,7 @@ def test_dual_arm_advance_term_sums_to_twice_its_weight_over_a_completed_task():
 @pytest.mark.parametrize("env_id", ["motiongym/HarvestArmPlanar-v0", "motiongym/HarvestArm-v0"])
 def test_harvest_observation_holds_the_fruit_error(env_id):
     env = gym.make(env_id)
-    layout = env.unwrapped.layout
+    layout = env.unwrapped.task.layout
     observation, info = env.reset(seed=4)
     for _ in range(3):
         error = layout.parse(observation)["fruit_error"]

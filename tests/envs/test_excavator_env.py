@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import warnings
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -67,16 +68,16 @@ def test_bad_input_raises(env_id):
             env.step(bad)
     with pytest.raises(ValueError, match="unknown reset option"):
         env.reset(options={"target": 1})
-    with pytest.raises(ValueError, match="q0"):
-        env.reset(options={"q0": [0.0, 1.0]})
+    with pytest.raises(ValueError, match=r"options\['start'\] must be an array of shape \(4,\)"):
+        env.reset(options={"start": [0.0, 1.0]})
     with pytest.raises(ValueError, match="render_mode"):
         type(env)(render_mode="human")
     with pytest.raises(ValueError, match="unknown keyword argument"):
         gym.make(env_id, unknown_weight=1.0)
     with pytest.raises(ValueError, match="options must be None or a dict"):
         env.reset(options="notadict")
-    with pytest.raises(ValueError, match="q0"):
-        env.reset(options={"q0": [0.0, np.nan, 0.0, 0.0]})
+    with pytest.raises(ValueError, match=r"options\['start'\] must be finite"):
+        env.reset(options={"start": [0.0, np.nan, 0.0, 0.0]})
 
 
 @pytest.mark.parametrize("env_id", IDS)
@@ -155,7 +156,7 @@ def test_digging_fills_the_bucket_slows_the_arm_and_pouring_spills():
     tip = np.array([np.cos(zone.azimuth), np.sin(zone.azimuth), 0.0]) * zone.r_far
     tip[2] = env.world.terrain.height_at(tip[0], tip[1]) + 0.05
     q0 = next(s for s in analytic_solutions(tip, -1.6, env.m) if within_limits(s, env.m))
-    env.reset(seed=seed, options={"q0": q0})
+    env.reset(seed=seed, options={"start": q0})
     volume0 = env.world.terrain.volume()
     rates = []
     for _ in range(8):  # boom down: the bucket enters the ground
@@ -199,7 +200,7 @@ def test_reach_success_terminates_with_the_bonus():
     assert info["position_error"] > env.params.tolerance_position and not info["is_success"]
     target = env.scene.target
     q = next(s for s in analytic_solutions(target[:3], target[3], env.m) if within_limits(s, env.m))
-    env.reset(seed=1, options={"q0": q})
+    env.reset(seed=1, options={"start": q})
     _, reward, terminated, _, info = env.step(np.zeros(4))
     assert terminated and info["is_success"]
     assert info["position_error"] < 1e-9 and info["angle_error"] < 1e-9
@@ -245,10 +246,84 @@ def test_digging_beside_the_zone_is_reported():
     tip = np.array([np.cos(azimuth), np.sin(azimuth), 0.0]) * zone.r_far
     tip[2] = env.world.terrain.height_at(tip[0], tip[1]) + 0.05
     q0 = next(s for s in analytic_solutions(tip, -1.6, env.m) if within_limits(s, env.m))
-    env.reset(seed=4, options={"q0": q0})
+    env.reset(seed=4, options={"start": q0})
     for _ in range(8):
         env.step(np.array([0.0, -0.15, 0.0, 0.0]))
     for _ in range(10):
         _, _, _, _, info = env.step(np.array([0.0, 0.0, -0.5, -0.2]))
     assert info["bucket_fill"] > 0.05
     assert info["outside_zone"] == pytest.approx(info["bucket_fill"], rel=1e-9)
+
+
+# ----------------------------------------------------------------- the core contract
+@pytest.mark.parametrize("env_id", ALL_IDS)
+def test_the_environments_are_system_envs_on_the_protocols(env_id):
+    from motiongym.envs import core
+
+    env = gym.make(env_id).unwrapped
+    assert isinstance(env, core.SystemEnv)
+    assert isinstance(env.world, core.World) and isinstance(env.task, core.Task)
+    assert env.action_space is env.world.action_space
+    assert env.observation_space is env.task.observation_space
+    assert env.task.reward_terms == type(env.params).REWARD_TERMS
+    _, info = env.reset(seed=0)
+    assert [k for k in info if k.startswith("reward_")] == [
+        f"reward_{t}" for t in env.task.reward_terms
+    ]
+    assert env.scene is env.world.scene and env.scene.start == env.m.q_ready
+
+
+@pytest.mark.parametrize("env_id", ["motiongym/ExcavatorReach-v0", "motiongym/Excavator-v1"])
+def test_the_start_option_and_its_deprecated_name_q0(env_id):
+    from motiongym.envs import checks, core
+
+    env = gym.make(env_id).unwrapped
+    q = np.array([0.3, 0.1, -1.2, -0.8])
+    new, _ = env.reset(seed=5, options={"start": q})
+    np.testing.assert_array_equal(env.scene.start, q)
+    assert env.world.q == pytest.approx(q.tolist(), abs=0.0)
+    checks._warned.clear()
+    with pytest.warns(core.MotiongymDeprecationWarning, match="reset option: 'q0' is deprecated"):
+        old, _ = env.reset(seed=5, options={"q0": q})
+    np.testing.assert_array_equal(old, new)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # once per process
+        env.reset(seed=5, options={"q0": q})
+    with pytest.raises(ValueError, match="give 'start' or its deprecated name 'q0', not both"):
+        env.reset(options={"start": q, "q0": q})
+    with pytest.raises(ValueError, match=r"options\['start'\] must be finite"):
+        env.reset(options={"q0": [0.0, np.inf, 0.0, 0.0]})
+
+
+@pytest.mark.parametrize(
+    ("env_id", "name", "cost"),
+    [
+        ("motiongym/ExcavatorReach-v0", "time", True),
+        ("motiongym/ExcavatorReach-v0", "contact", True),
+        ("motiongym/ExcavatorReach-v1", "closeness", False),
+        ("motiongym/Excavator-v0", "spill", True),
+        ("motiongym/Excavator-v1", "approach", False),
+        ("motiongym/Excavator-v1", "delivered", False),
+    ],
+)
+def test_reward_weights_are_magnitudes(env_id, name, cost):
+    why = (
+        rf"a cost term is subtracted \(give {name}=0.5 for the same reward\)"
+        if cost
+        else rf"{name} is paid \(added\), so no weight makes it a cost"
+    )
+    with pytest.raises(ValueError, match=rf"{name} must be a reward weight .*got -0.5: .*{why}"):
+        gym.make(env_id, **{name: -0.5})
+    with pytest.raises(ValueError, match=rf"{name} must be a finite number in \[0.0, 1000000.0\]"):
+        gym.make(env_id, **{name: 2e6})
+    assert gym.make(env_id, **{name: 0.0}).unwrapped.params.weights[name] == 0.0
+
+
+@pytest.mark.parametrize("size", [(720, 1280), (16, 2048), (2048, 16)])
+def test_every_allowed_render_size_renders(size):
+    """Past MuJoCo's default 640 x 480 offscreen buffer too (the world enlarges it)."""
+    env = gym.make("motiongym/ExcavatorReach-v1", render_mode="rgb_array", render_size=size)
+    env.reset(seed=1)
+    frame = env.render()
+    assert frame.shape == (*size, 3) and frame.dtype == np.uint8 and frame.std() > 1
+    env.close()

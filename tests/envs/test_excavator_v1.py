@@ -2,7 +2,7 @@
 
 The machine is driven through the environment (actions only) on a level,
 flat scene built here (pipe and truck placed by the test); poses are set
-through the ``q0`` reset option from the closed-form IK, and every expected
+through the ``start`` reset option from the closed-form IK, and every expected
 position (corners, tips, pins) comes from :mod:`motiongym.envs.excavator.kinematics`
 (the paper's matrix chain), not from the world's own code.
 """
@@ -44,7 +44,7 @@ def _env(task="dig", pipe=FAR_PIPE, truck=FAR_TRUCK, q0=None, **kwargs):
         target=np.array([6.0, 0.0, 1.0, -1.6]),
     )
     env.task.sample_scene = lambda rng: scene
-    options = None if q0 is None else {"q0": q0}
+    options = None if q0 is None else {"start": q0}
     env.reset(seed=0, options=options)
     return env
 

@@ -16,6 +16,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env  # n
 import motiongym  # noqa: E402, F401
 from motiongym.envs.geometry import closest_points_between_segments  # noqa: E402
 from motiongym.envs.harvest_arm.model import ArmKinematics, arm_spec  # noqa: E402
+from motiongym.envs.harvest_arm.observation import observation_views  # noqa: E402
 from motiongym.envs.harvest_arm.task import (  # noqa: E402
     START_CLEARANCE,
     clearance_to_arm,
@@ -36,7 +37,7 @@ def test_every_arm_passes_the_gymnasium_and_sb3_checkers(planar, dof):
     check_env(env.unwrapped, skip_render_check=True)
     sb3_check_env(_make(planar, dof), warn=True)
     observation, _ = env.reset(seed=0)
-    assert observation.shape == (env.unwrapped.layout.size,)
+    assert observation.shape == (env.unwrapped.task.layout.size,)
 
 
 def test_a465_table_3_ranges_and_speeds():
@@ -69,14 +70,14 @@ def test_clearances_match_numpy_geometry_and_mj_geom_distance():
     env = _make(False, 7).unwrapped
     rng = np.random.default_rng(0)
     for seed in range(3):
-        observation, _ = env.reset(seed=seed, options={"q": rng.uniform(-1, 1, 7)})
-        o = env.layout.parse(observation)
+        observation, _ = env.reset(seed=seed, options={"start": rng.uniform(-1, 1, 7)})
+        o = observation_views(env.task.layout, observation)
         scene = env.scene
         points = o["points"]
         dist, _, _ = closest_points_between_segments(
             points[:-1, None], points[1:, None], o["a"][None], o["b"][None]
         )
-        expected = np.minimum(dist - env.link_radius - o["radius"][None], 1.0)  # (L, K)
+        expected = np.minimum(dist - env.params.link_radius - o["radius"][None], 1.0)  # (L, K)
         np.testing.assert_allclose(o["distances"], expected, atol=1e-6)
         assert scene.is_bar.sum() == 3
         fromto = np.zeros(6)
@@ -94,11 +95,11 @@ def test_clearances_stay_exact_along_a_rollout(planar, dof):
     rng = np.random.default_rng(5)
     for _ in range(40):
         observation, *_ = env.step(rng.uniform(-1, 1, dof).astype(np.float32))
-        o = env.layout.parse(observation)
+        o = observation_views(env.task.layout, observation)
         dist, _, _ = closest_points_between_segments(
             o["points"][:-1, None], o["points"][1:, None], o["a"][None], o["b"][None]
         )
-        expected = np.minimum(dist - env.link_radius - o["radius"][None], 1.0)
+        expected = np.minimum(dist - env.params.link_radius - o["radius"][None], 1.0)
         np.testing.assert_allclose(o["distances"], expected, atol=1e-5)
 
 
@@ -109,13 +110,13 @@ def test_planar_clearance_of_a_known_case():
     centre = [1.5 * length, 0.1]
     observation, info = env.reset(
         options={
-            "q": np.zeros(3),
+            "start": np.zeros(3),
             "fruit": [0.5, -0.3],
             "obstacles": [{"center": centre, "radius": 0.02}],
         }
     )
     assert info["min_distance"] == pytest.approx(0.1 - 0.02 - 0.02, abs=1e-9)
-    o = env.layout.parse(observation)
+    o = observation_views(env.task.layout, observation)
     assert o["mask"].sum() == 1
     assert o["distances"][1, 0] == pytest.approx(0.06, abs=1e-6)
     assert (o["distances"][:, 1:] == 1.0).all()  # empty slots read the clip value
@@ -129,9 +130,9 @@ def test_scenes_are_reachable_and_clear_of_the_start_pose(planar, dof):
         scene = env.scene
         assert len(scene) == (8 if planar else 10)
         assert scene.is_bar.sum() == (0 if planar else 3)
-        kin = env.kinematics
+        kin = env.world.kinematics
         start = kin.forward(np.array(kin.spec.home))
-        assert clearance_to_arm(start, env.link_radius, scene).min() >= START_CLEARANCE
+        assert clearance_to_arm(start, env.params.link_radius, scene).min() >= START_CLEARANCE
         assert solve_ik(kin, scene.fruit, np.array(kin.spec.home))[1] < 2e-3
 
 
@@ -155,10 +156,10 @@ def test_reward_terms_sum_and_info_keys():
 
 def test_arriving_at_the_fruit_terminates_with_success():
     env = _make(True, 3).unwrapped
-    kin = env.kinematics
+    kin = env.world.kinematics
     q_goal, _ = solve_ik(kin, np.array([0.5, -0.3]), np.array(kin.spec.home))
     fruit = kin.forward(q_goal)[-1]
-    env.reset(options={"q": q_goal, "fruit": fruit, "obstacles": []})
+    env.reset(options={"start": q_goal, "fruit": fruit, "obstacles": []})
     _, reward, terminated, _, info = env.step(np.zeros(3, np.float32))
     assert terminated and info["is_success"]
     assert info["reward_success"] == pytest.approx(10.0)
@@ -191,12 +192,17 @@ def test_bad_input_is_rejected_with_the_valid_choices():
         ({"self_collision": 1}, "self_collision must be True or False"),
         ({"render_mode": "depth"}, "render_mode must be one of"),
         ({"width": 0}, "width must be an integer"),
+        ({"render_size": (360, 4096)}, r"render_size\[1\] must be an integer in \[16, 2048\]"),
+        ({"effort": -0.5}, "give effort=0.5 for the same reward"),
+        ({"effort": 1e308}, r"effort must be a finite number in \[0.0, 1000000.0\]"),
     ]
     for kwargs, message in bad_kwargs:
         with pytest.raises(ValueError, match=message):
             gym.make("motiongym/HarvestArm-v1", **kwargs)
     env = _make(True, 3)
-    with pytest.raises(ValueError, match="valid"):
+    with pytest.raises(ValueError, match="valid: fruit, obstacles, start"):
+        env.reset(options={"q0": 1})
+    with pytest.raises(ValueError, match=r"options\['start'\] must be an array of shape \(3,\)"):
         env.reset(options={"start": 1})
     with pytest.raises(ValueError, match="None or a dict"):
         env.reset(options="notadict")
@@ -207,8 +213,8 @@ def test_bad_input_is_rejected_with_the_valid_choices():
     nan_obstacle = [{"center": [np.nan, 0.1], "radius": 0.02}]
     with pytest.raises(ValueError, match=r"options\['obstacles'\]\[0\]\['center'\] must be finite"):
         env.reset(options={"fruit": [0.5, 0.0], "obstacles": nan_obstacle})
-    with pytest.raises(ValueError, match=r"options\['q'\] must be finite"):
-        env.reset(options={"q": [np.nan, 0.0, 0.0]})
+    with pytest.raises(ValueError, match=r"options\['start'\] must be finite"):
+        env.reset(options={"start": [np.nan, 0.0, 0.0]})
     inside = [{"center": [0.51, 0.0], "radius": 0.02}]
     with pytest.raises(ValueError, match=r"\[0\] must not overlap the fruit"):
         env.reset(options={"fruit": [0.5, 0.0], "obstacles": inside})
@@ -226,7 +232,7 @@ def test_bad_input_is_rejected_with_the_valid_choices():
 
 def test_an_unreachable_fruit_ends_by_the_time_limit():
     """Documented outcome: accepted, the episode truncates unsuccessfully (no hang)."""
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
     from motiongym.baselines import make_policy
 
     env = gym.make("motiongym/HarvestArmPlanar-v1", dof=3)
@@ -240,7 +246,7 @@ def test_an_unreachable_fruit_ends_by_the_time_limit():
 
 
 def test_render_rgb_array_shows_the_scene():
-    env = _make(False, 7, render_mode="rgb_array", width=160, height=120)
+    env = _make(False, 7, render_mode="rgb_array", render_size=(120, 160))
     env.reset(seed=0)
     for _ in range(3):
         env.step(env.action_space.sample())
@@ -259,14 +265,14 @@ def test_v1_self_distance_is_the_brute_force_distance_of_non_adjacent_links(plan
     env_id = "motiongym/HarvestArmPlanar-v1" if planar else "motiongym/HarvestArm-v1"
     env = gym.make(env_id, dof=dof, terminate_on_collision=False)
     base = env.unwrapped
-    kin = ArmKinematics(base.spec_arm)
+    kin = ArmKinematics(base.world.arm)
     rng = np.random.default_rng(dof + 10 * planar)
-    limits = base.spec_arm.limits
-    r = base.link_radius
+    limits = base.world.arm.limits
+    r = base.params.link_radius
     seen_collision = seen_clear = 0
     for _ in range(60):
         q = rng.uniform(-limits, limits)
-        _, info = env.reset(seed=1, options={"q": q})
+        _, info = env.reset(seed=1, options={"start": q})
         _, _, _, _, info = env.step(np.zeros(dof, dtype=np.float32))
         points = kin.forward(q)
         p0, p1 = points[:-1], points[1:]
@@ -280,7 +286,7 @@ def test_v1_self_distance_is_the_brute_force_distance_of_non_adjacent_links(plan
         if brute <= 0.0:
             seen_collision += 1
             assert info["collision"] and info["cost"] == 1.0
-            assert info["reward_collision"] == -base.weights["collision"]
+            assert info["reward_collision"] == -base.params.collision
         else:
             seen_clear += 1
     assert seen_clear > 0
@@ -292,7 +298,7 @@ def test_v1_terminates_on_self_collision_and_v0_ignores_it():
     """A planar 5-DOF arm folded back onto itself, no obstacle near."""
     q = np.array([0.0, 2.6, 2.6, 2.6, 0.0])
     far = [{"center": [0.8, 0.5], "radius": 0.01}]
-    options = {"q": q, "fruit": np.array([0.5, -0.4]), "obstacles": far}
+    options = {"start": q, "fruit": np.array([0.5, -0.4]), "obstacles": far}
     v1 = gym.make("motiongym/HarvestArmPlanar-v1")
     v1.reset(seed=0, options=options)
     _, _, terminated, _, info = v1.step(np.zeros(5, dtype=np.float32))
@@ -305,10 +311,85 @@ def test_v1_terminates_on_self_collision_and_v0_ignores_it():
 
 def test_docstring_table_is_the_default_arms_layout():
     env = gym.make("motiongym/HarvestArm-v1").unwrapped
-    table = env.layout.table()
+    layout = env.task.layout
+    table = layout.table()
     doc = "\n".join(line.strip() for line in type(env).__doc__.splitlines())
     assert "\n".join(line.strip() for line in table.splitlines()) in doc
     observation, _ = env.reset(seed=0)
-    assert set(env.layout.parse(observation)) >= {"q", "points", "distances"}
+    assert set(observation_views(layout, observation)) >= {"q", "points", "distances"}
     with pytest.raises(ValueError, match="shape"):
-        env.layout.parse(observation[:-1])  # the fields cover the whole vector
+        layout.parse(observation[:-1])  # the fields cover the whole vector
+
+
+def test_the_env_is_a_world_and_a_task_on_the_core_contract():
+    from motiongym.envs import core
+    from motiongym.envs.harvest_arm.observation import layout_for, point_count
+
+    env = _make(False, 7).unwrapped
+    assert isinstance(env, core.SystemEnv)
+    assert isinstance(env.world, core.World) and isinstance(env.task, core.Task)
+    assert type(env).step is core.SystemEnv.step and type(env).reset is core.SystemEnv.reset
+    assert env.dt == 0.05
+    for planar, dof in ARMS:  # the layout's point count is the model's
+        arm = arm_spec(dof, planar)
+        assert point_count(arm) == ArmKinematics(arm).n_points
+    p = env.params
+    assert layout_for(p).size == env.observation_space.shape[0]
+
+
+def test_deprecated_width_and_height_become_render_size_and_warn_once():
+    from motiongym.envs import checks, core
+
+    checks._warned.clear()
+    with pytest.warns(core.MotiongymDeprecationWarning, match="'width' is deprecated"):
+        env = _make(False, 7, width=160)
+    assert env.unwrapped.params.render_size == (360, 160)
+    with pytest.warns(core.MotiongymDeprecationWarning, match="'height' is deprecated"):
+        env = _make(False, 7, width=160, height=120)
+    assert env.unwrapped.params.render_size == (120, 160)
+    with pytest.raises(ValueError, match="give 'render_size' or its deprecated name 'width'"):
+        _make(False, 7, width=160, render_size=(120, 160))
+    with pytest.raises(ValueError, match=r"height must be an integer in \[16, 2048\], got 5000"):
+        _make(False, 7, height=5000)
+
+
+def test_deprecated_reset_option_q_is_start_and_warns_once():
+    from motiongym.envs import checks, core
+
+    checks._warned.clear()
+    q = np.array([0.3, -0.4, 0.5])
+    new = _make(True, 3)
+    old = _make(True, 3)
+    observation, info = new.reset(seed=4, options={"start": q})
+    with pytest.warns(core.MotiongymDeprecationWarning, match="reset option: 'q' is deprecated"):
+        observation_q, info_q = old.reset(seed=4, options={"q": q})
+    np.testing.assert_array_equal(observation_q, observation)
+    assert info_q == info
+    np.testing.assert_allclose(new.unwrapped.world.q, q)
+    with pytest.raises(ValueError, match="give 'start' or its deprecated name 'q'"):
+        old.reset(options={"q": q, "start": q})
+
+
+def test_reward_weights_are_magnitudes():
+    for term in ("progress", "clearance", "collision", "effort", "success", "distance"):
+        with pytest.raises(ValueError, match=f"give {term}=2.0 for the same reward"):
+            gym.make("motiongym/HarvestArm-v1", **{term: -2.0})
+        with pytest.raises(ValueError, match=f"{term} must be a finite number in"):
+            gym.make("motiongym/HarvestArm-v1", **{term: 1e308})
+    env = gym.make("motiongym/HarvestArm-v1", effort=1e6, distance=1e6)  # the largest allowed
+    env.reset(seed=0)
+    _, reward, *_, info = env.step(np.ones(7, np.float32))
+    assert np.isfinite(reward) and info["reward_effort"] == -1e6
+
+
+def test_a_large_render_size_renders_at_that_size():
+    env = _make(True, 5, render_mode="rgb_array", render_size=(1200, 1600))
+    env.reset(seed=0)
+    env.step(np.full(5, 0.5, np.float32))
+    try:
+        frame = env.render()
+    except Exception as error:  # pragma: no cover - machines without EGL
+        pytest.skip(f"offscreen rendering unavailable: {error}")
+    assert frame.shape == (1200, 1600, 3)
+    assert frame.std() > 5
+    env.close()

@@ -74,7 +74,7 @@ def test_reward_terms_sum_and_info_keys() -> None:
 
 
 def test_forward_sweeps_a_new_row_and_bump_stays() -> None:
-    env = SweeperEnv(grid=empty_room(8, 10), robot_width=3, time=-0.1)
+    env = SweeperEnv(grid=empty_room(8, 10), robot_width=3, time=0.1)
     obs, info = env.reset(seed=0, options={"start": (1, 1), "heading": 0})
     assert info["coverage"] == pytest.approx(9 / 48)
     obs, r, _, _, info = env.step(FORWARD)

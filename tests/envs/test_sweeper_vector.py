@@ -271,7 +271,7 @@ def test_bad_construction_raises() -> None:
 
 
 def test_sb3_adapter_over_native_vector_env() -> None:
-    from motiongym.agents.vector import VectorEnvAdapter
+    from motiongym.agents.training.vector import VectorEnvAdapter
 
     venv = VectorEnvAdapter(SweeperVectorEnv(num_envs=4, max_episode_steps=6))
     venv.seed(0)
@@ -289,7 +289,7 @@ def test_sb3_adapter_over_native_vector_env() -> None:
 
 
 def test_render_matches_single_env() -> None:
-    kwargs = {"grid": empty_room(8, 11), "render_mode": "rgb_array", "cell_pixels": 4}
+    kwargs = {"grid": empty_room(8, 11), "render_mode": "rgb_array", "render_size": (40, 50)}
     env = SweeperVectorEnv(num_envs=2, max_episode_steps=30, **kwargs)
     sync = sync_twin(2, 30, **kwargs)
     env.reset(seed=2)
@@ -323,7 +323,7 @@ def test_make_vec_vector_entry_point() -> None:
         ({"map_name": "maze", "coarse": 1, "sensor_range": 6}, 4, 400),
         ({"map_name": "random-maze", "robot_width": 2}, 6, 200),
         ({"map_name": "random-apartment", "robot_width": 5, "sensor_range": 2}, 6, 200),
-        ({"map_name": "random", "time": -0.3, "bump": -2.5}, 8, 150),
+        ({"map_name": "random", "time": 0.3, "bump": 2.5}, 8, 150),
         ({"map_name": "apartment", "robot_width": 1, "line_of_sight": True}, 4, 400),
         ({"map_name": "random-apartment", "sensor_range": 6, "line_of_sight": True}, 6, 200),
     ],

@@ -32,48 +32,84 @@ LAYOUT = core.ObservationLayout(
 @dataclass(frozen=True)
 class ToyParams:
     length: float = 10.0  # m
-    time: float = 0.1  # weight of the time term
+    time: float = 0.1  # weight of the time term (a cost: subtracted)
+    render_size: tuple[int, int] = (16, 64)  # rows, columns
 
     def __post_init__(self) -> None:
         core.check_float("length", self.length, 1.0, 100.0)
-        core.check_float("time", self.time, 0.0, 10.0)
+        core.check_weight("time", self.time)
+        object.__setattr__(
+            self, "render_size", core.check_render_size("render_size", self.render_size)
+        )
 
 
-class ToyLineEnv(core.NeedsReset, gym.Env):
+@dataclass
+class Scene:
+    position: int
+    goal: int
+
+
+class ToyWorld:
+    """The point on its line: the only code that moves it."""
+
+    def __init__(self, params: ToyParams) -> None:
+        self.length = int(params.length)
+        self.action_space = spaces.Discrete(2)
+        self.scene: Scene | None = None
+
+    def reset(self, scene: Scene, rng: np.random.Generator) -> None:
+        self.scene = scene
+        self.position = scene.position
+
+    def advance(self, action: int) -> None:
+        self.position = min(max(self.position + (1 if action == 1 else -1), 0), self.length)
+
+    def render(self, size: tuple[int, int]) -> np.ndarray:
+        frame = np.zeros((*size, 3), np.uint8)
+        frame[:, int(self.position / self.length * (size[1] - 1))] = 255
+        return frame
+
+
+class ToyTask:
+    """Reach the goal; every step costs ``time``."""
+
+    reward_terms = ("time",)
+
+    def __init__(self, params: ToyParams) -> None:
+        self.params = params
+        low, high = LAYOUT.bounds({"position": (0, params.length), "goal": (0, params.length)})
+        self.observation_space = spaces.Box(low, high)
+        self.options = {core.START: lambda name, v: core.check_int(name, v, 0, int(params.length))}
+
+    def sample(self, rng: np.random.Generator, options: dict) -> Scene:
+        position, goal = rng.integers(0, int(self.params.length), 2)
+        return Scene(int(options.get(core.START, position)), int(goal))
+
+    def begin(self, world: ToyWorld) -> core.Outcome:
+        return core.Outcome(core.zero_terms(self.reward_terms), False, 0.0, {}, False)
+
+    def evaluate(self, world: ToyWorld, events: None) -> core.Outcome:
+        done = world.position == world.scene.goal
+        return core.Outcome({"time": -self.params.time}, done, 0.0, {}, done)
+
+    def observe(self, world: ToyWorld) -> np.ndarray:
+        return LAYOUT.pack({"position": world.position, "goal": world.scene.goal})
+
+
+class ToyLineEnv(core.SystemEnv):
     """Walk a point to a goal on a line. Action Discrete(2): 0 left, 1 right."""
 
-    metadata = {"render_modes": [], "info_measures": {"is_success": "last", "cost": "sum"}}
+    Params = ToyParams
+    metadata = {
+        "render_modes": ["rgb_array"],
+        "info_measures": {"is_success": "last", "cost": "sum"},
+    }
 
-    def __init__(self, render_mode: str | None = None, **kwargs: Any) -> None:
-        self.render_mode = core.check_render_mode(render_mode, self.metadata["render_modes"])
-        self.params = core.params_from_kwargs(ToyParams, kwargs)
-        low, high = LAYOUT.bounds(
-            {"position": (0, self.params.length), "goal": (0, self.params.length)}
-        )
-        self.observation_space = spaces.Box(low, high)
-        self.action_space = spaces.Discrete(2)
+    def make_world(self, params: ToyParams) -> ToyWorld:
+        return ToyWorld(params)
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        core.check_options(options, {})
-        self.position, self.goal = self.np_random.integers(0, int(self.params.length), 2)
-        self._was_reset = True
-        _, info = core.reward_and_info(core.zero_terms(["time"]), cost=0.0, is_success=False)
-        return self._observation(), info
-
-    def step(self, action: Any):
-        self._require_reset("step")
-        if not self.action_space.contains(action):
-            raise ValueError(f"action must be in {self.action_space}, got {action!r}")
-        self.position = int(
-            np.clip(self.position + (1 if action == 1 else -1), 0, self.params.length)
-        )
-        done = self.position == self.goal
-        reward, info = core.reward_and_info({"time": -self.params.time}, cost=0.0, is_success=done)
-        return self._observation(), reward, done, False, info
-
-    def _observation(self) -> np.ndarray:
-        return LAYOUT.pack({"position": self.position, "goal": self.goal})
+    def make_task(self, params: ToyParams) -> ToyTask:
+        return ToyTask(params)
 
 
 # ---------------------------------------------------------------- baselines module
@@ -94,7 +130,7 @@ class WalkPolicy(ScriptedPolicy):
 
 # ---------------------------------------------------------------- reproduction module
 def run(out_dir: Path, quick: bool = False) -> dict:
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
     from motiongym.baselines import make_policy
 
     env = gym.make("motiongym/ToyLine-v0")
