@@ -59,8 +59,8 @@ test-zoo:
 	$(ZOO_VENV)/bin/python -m pip install --quiet -e ".[dev]" "rl_zoo3>=2.9,<3"
 	MUJOCO_GL=egl $(ZOO_VENV)/bin/pytest -q -m slow -p no:cacheprovider tests/agents/test_zoo_train.py
 
-# The type check (mypy, [tool.mypy] in pyproject.toml) of envs/ and baselines/ reads the
-# package through links in build/typecheck: setup.py maps the folders to the import name
+# The type check (mypy, [tool.mypy] in pyproject.toml) of envs/, baselines/ and agents/
+# reads the package through links in build/typecheck: setup.py maps the folders to the import name
 # motiongym, which mypy cannot follow.
 TYPED := build/typecheck/motiongym
 lint: $(STAMP)
@@ -69,9 +69,9 @@ lint: $(STAMP)
 	rm -rf $(TYPED) && mkdir -p $(TYPED)
 	for f in __init__.py systems.py py.typed; do ln -s $(CURDIR)/src/motiongym/$$f $(TYPED)/$$f; done
 	for d in envs baselines agents configs; do ln -s $(CURDIR)/$$d $(TYPED)/$$d; done
-	$(BIN)/mypy -p motiongym.envs -p motiongym.baselines
+	$(BIN)/mypy -p motiongym.envs -p motiongym.baselines -p motiongym.agents
 
-# The shipped models (agents/pretrained/): every ID's configs/<ID>.yml first block
+# The shipped models (agents/models/pretrained/): every ID's configs/<ID>.yml first block
 # and the dual-arm shared-parameter block, three training seeds each; `ship`
 # evaluates every seed on held-out episodes and ships the best. Hours on 2 cores.
 SEEDS ?= 0 1 2

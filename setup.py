@@ -26,7 +26,7 @@ setup(
         "motiongym": ["py.typed"],
         "": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.npz"],
         # shipped models: pretrained/<ID>/<label>/ are folders, not packages
-        "motiongym.agents": ["pretrained/*/*/*"],
+        "motiongym.agents.models": ["pretrained/*/*/*"],
         # folders of YAML files, not packages: rl-zoo3's and RLlib's settings
         "motiongym.configs": ["zoo/*.yml", "rllib/*.yml"],
     },

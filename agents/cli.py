@@ -1,5 +1,5 @@
 """The ``motiongym`` command: list, evaluate, compare, train, dataset, ship, record, benchmarks,
-reproduce, bench; sweep and rllib (Ray, :mod:`motiongym.agents.ray_commands`).
+reproduce, bench; sweep and rllib (Ray, :mod:`motiongym.agents.integrations.ray_commands`).
 
 Bad input (an unknown ID, policy, algorithm, experiment or configuration key, a
 malformed YAML file, a model built for another space) ends in one line on
@@ -16,9 +16,15 @@ from typing import Any
 
 import yaml
 
-from motiongym.agents.environments import check_env_id, make_env, short_name
+from motiongym.agents.environments import (
+    LONG_EPISODE,
+    check_env_id,
+    long_episodes_note,
+    make_env,
+    short_name,
+)
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import EVALUATION_SEED, Evaluation
+from motiongym.agents.evaluation.episodes import EVALUATION_SEED, Evaluation
 from motiongym.baselines.registry import UnknownPolicyError
 from motiongym.envs import ENV_IDS
 from motiongym.envs.core import ArgumentError
@@ -111,21 +117,44 @@ def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
     return kwargs
 
 
+def note(message: str) -> None:
+    """One line on standard error, before long work (never in the tables)."""
+    print(f"motiongym: {message}", file=sys.stderr)
+
+
+def _capped(env_kwargs: dict[str, Any], max_steps: int | None) -> dict[str, Any]:
+    """``env_kwargs`` with ``--max-steps`` as gym.make's ``max_episode_steps``."""
+    if max_steps is None:
+        return env_kwargs
+    given = env_kwargs.get("max_episode_steps", max_steps)
+    if given != max_steps:
+        raise UsageError(
+            f"--max-steps {max_steps} and --env-kwargs max_episode_steps={given} disagree"
+        )
+    return {**env_kwargs, "max_episode_steps": max_steps}
+
+
 def _evaluations(env_id: str, policies: list[str], args: argparse.Namespace) -> list[Evaluation]:
     """Every policy on the same seeded episodes of ``env_id``."""
-    from motiongym.agents.evaluate import evaluate
-    from motiongym.agents.predictors import load_predictor, policy_label
+    from motiongym.agents.evaluation.episodes import evaluate
+    from motiongym.agents.models.predictors import load_predictor, policy_label
 
-    env_kwargs = _env_kwargs(args.env_kwargs)
+    env_kwargs = _capped(_env_kwargs(args.env_kwargs), args.max_steps)
     if args.seed + args.episodes - 1 > MAX_SEED:
         raise UsageError(f"--seed {args.seed} + --episodes {args.episodes} passes {MAX_SEED}")
     env = make_env(env_id, env_kwargs)
     seeds = range(args.seed, args.seed + args.episodes)
-    results = []
-    for policy in policies:
-        predictor = load_predictor(policy, env_id, env, env_kwargs, trust=args.trust)
-        label = policy_label(policy)
-        results.append(evaluate(env, predictor, seeds, env_id, label, not args.no_progress))
+    predictors = [
+        (load_predictor(policy, env_id, env, env_kwargs, trust=args.trust), policy_label(policy))
+        for policy in policies
+    ]
+    long = long_episodes_note(env_id, env_kwargs, args.episodes)
+    if long is not None:  # said once every policy has loaded, before the first episode
+        note(f"{long} (--max-steps N caps them)")
+    results = [
+        evaluate(env, predictor, seeds, env_id, label, not args.no_progress)
+        for predictor, label in predictors
+    ]
     env.close()
     return results
 
@@ -133,8 +162,8 @@ def _evaluations(env_id: str, policies: list[str], args: argparse.Namespace) -> 
 def cmd_list(args: argparse.Namespace) -> None:
     from rich.table import Table
 
-    from motiongym.agents.predictors import available_policies
-    from motiongym.agents.report import console
+    from motiongym.agents.evaluation.report import console
+    from motiongym.agents.models.predictors import available_policies
 
     table = Table(title="motiongym environments")
     table.add_column("ID")
@@ -145,7 +174,7 @@ def cmd_list(args: argparse.Namespace) -> None:
 
 
 def cmd_evaluate(args: argparse.Namespace) -> None:
-    from motiongym.agents.report import console, summary_table, write_evaluation
+    from motiongym.agents.evaluation.report import console, summary_table, write_evaluation
 
     check_env_id(args.env_id)
     (evaluation,) = _evaluations(args.env_id, [args.policy], args)
@@ -155,12 +184,18 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
 
 
 def cmd_compare(args: argparse.Namespace) -> None:
-    from motiongym.agents.predictors import available_policies
-    from motiongym.agents.report import comparison_table, console, write_comparison
+    from motiongym.agents.evaluation.report import (
+        comparison_summary,
+        comparison_table,
+        console,
+        write_comparison,
+    )
+    from motiongym.agents.models.predictors import available_policies
 
     if args.all == (args.env_id is not None):
         raise UsageError("compare takes an environment ID or --all, not both")
     env_ids = ENV_IDS if args.all else [check_env_id(args.env_id)]
+    written: dict[str, list[Path]] = {}
     for env_id in env_ids:
         policies = args.policies or available_policies(env_id)
         if not policies:
@@ -168,13 +203,16 @@ def cmd_compare(args: argparse.Namespace) -> None:
             continue
         evaluations = _evaluations(env_id, policies, args)
         console.print(comparison_table(evaluations))
-        for path in write_comparison(evaluations, args.out, short_name(env_id)):
+        written[env_id] = write_comparison(evaluations, args.out, short_name(env_id))
+        for path in written[env_id]:
             console.print(f"wrote {path}")
+    if len(env_ids) > 1 and written:
+        console.print(comparison_summary(written, args.out, args.episodes))
 
 
 def cmd_train(args: argparse.Namespace) -> None:
-    from motiongym.agents.report import console
-    from motiongym.agents.train import train
+    from motiongym.agents.evaluation.report import console
+    from motiongym.agents.training.train import train
 
     run_dir = train(
         args.env_id,
@@ -189,8 +227,8 @@ def cmd_train(args: argparse.Namespace) -> None:
 
 
 def cmd_dataset(args: argparse.Namespace) -> None:
-    from motiongym.agents.dataset import record_dataset
-    from motiongym.agents.report import console
+    from motiongym.agents.evaluation.report import console
+    from motiongym.agents.integrations.dataset import record_dataset
 
     check_env_id(args.env_id)
     if args.seed + args.episodes - 1 > MAX_SEED:
@@ -207,10 +245,12 @@ def cmd_dataset(args: argparse.Namespace) -> None:
 
 
 def cmd_ship(args: argparse.Namespace) -> None:
-    from motiongym.agents.report import console
-    from motiongym.agents.ship import describe, ship
+    from motiongym.agents.evaluation.report import console
+    from motiongym.agents.models.ship import describe, ship
 
-    shipped = ship(args.run_dirs, n_episodes=args.episodes, root=args.into, force=args.force)
+    shipped = ship(
+        args.run_dirs, n_episodes=args.episodes, root=args.into, force=args.force, announce=note
+    )
     console.print(
         f"shipped to {shipped.folder}: {describe(shipped.score)} on the held-out episodes"
     )
@@ -219,8 +259,8 @@ def cmd_ship(args: argparse.Namespace) -> None:
 
 
 def cmd_record(args: argparse.Namespace) -> None:
-    from motiongym.agents.record import record
-    from motiongym.agents.report import console
+    from motiongym.agents.evaluation.record import record
+    from motiongym.agents.evaluation.report import console
     from motiongym.baselines import scripted_policies
 
     check_env_id(args.env_id)
@@ -247,8 +287,8 @@ def cmd_record(args: argparse.Namespace) -> None:
 
 
 def cmd_benchmarks(args: argparse.Namespace) -> None:
-    from motiongym.agents.benchmarks import write_benchmarks
-    from motiongym.agents.report import console
+    from motiongym.agents.evaluation.benchmarks import write_benchmarks
+    from motiongym.agents.evaluation.report import console
 
     try:
         path = write_benchmarks(args.out, n_episodes=args.episodes, ids=args.ids)
@@ -264,7 +304,7 @@ def cmd_reproduce(args: argparse.Namespace) -> None:
 
 
 def cmd_bench(args: argparse.Namespace) -> None:
-    from motiongym.agents.throughput import bench
+    from motiongym.agents.bench.throughput import bench
 
     bench(args.out, quick=args.quick, env_ids=args.ids or None)
 
@@ -304,6 +344,14 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
     )
     _env_kwargs_option(parser)
     parser.add_argument(
+        "--max-steps",
+        type=_count,
+        default=None,
+        help="cap every episode at N steps, a capped episode ending truncated (default: the "
+        "ID's own limit, the benchmarks' protocol; an ID whose limit passes "
+        f"{LONG_EPISODE:,} steps is announced before it starts)",
+    )
+    parser.add_argument(
         "--out", type=_folder, default=Path("results"), help="output folder (default results)"
     )
     parser.add_argument(
@@ -313,7 +361,7 @@ def _evaluation_options(parser: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from motiongym.agents.model_files import algorithm_classes
+    from motiongym.agents.models.files import algorithm_classes
     from motiongym.agents.reproduce import EXPERIMENTS
 
     parser = _Parser(
@@ -371,7 +419,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     train.set_defaults(handler=cmd_train)
 
-    from motiongym.agents.dataset import DATASET_SEED
+    from motiongym.agents.integrations.dataset import DATASET_SEED
 
     dataset = commands.add_parser(
         "dataset", help="record a scripted policy's episodes as a Minari dataset (offline RL)"
@@ -404,7 +452,7 @@ def build_parser() -> argparse.ArgumentParser:
     ship.add_argument(
         "--into",
         type=_folder,
-        help="folder that holds <ID>/<label>/ (default: the package's agents/pretrained)",
+        help="folder that holds <ID>/<label>/ (default: the package's agents/models/pretrained)",
     )
     ship.add_argument(
         "--force",
@@ -481,7 +529,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bench.set_defaults(handler=cmd_bench)
 
-    from motiongym.agents.ray_commands import add_ray_commands
+    from motiongym.agents.integrations.ray_commands import add_ray_commands
 
     add_ray_commands(commands, _count, _seed, _folder)
     return parser

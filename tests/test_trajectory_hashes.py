@@ -3,11 +3,12 @@
 ``tests/data/trajectory_hashes.json`` holds, for every (ID, policy) pair, the
 SHA-256 of the first ``STEPS`` steps of seeded episodes (observations,
 actions, rewards, termination flags and every numeric ``info`` value, as
-bytes) and, for ``random``, of seeded random actions. It was recorded before
-the restructuring of issue 13; a refactor must leave every hash as it is. A
-deliberate change of behaviour comes with a new ID version (the old one
-keeps its hashes) or, for a scripted policy, a re-recording named in the
-commit (``python tests/test_trajectory_hashes.py --record``).
+bytes) and, for ``random``, of seeded random actions. A refactor must leave
+every hash as it is; a pair without a record fails, so a new ID or policy is
+recorded when it is added. A deliberate change of behaviour comes with a new
+ID version (the old one keeps its hashes) or, for a scripted policy, a
+re-recording named in the commit
+(``python tests/test_trajectory_hashes.py --record [substring ...]``).
 
 Bit-identical episodes are what the hash pins on the machine that recorded
 it. NumPy's BLAS picks its kernels by processor (and by ``OPENBLAS_CORETYPE``),
@@ -133,8 +134,10 @@ def _recorded(path: Path = DATA) -> dict:
 def test_trajectory_unchanged(env_id, policy_name):
     key = f"{env_id} {policy_name}"
     recorded = _recorded()
-    if key not in recorded:
-        pytest.skip(f"no hash recorded for {key} (new ID or policy)")
+    assert key in recorded, (
+        f"no hash recorded for {key}: record it with "
+        f"`python tests/test_trajectory_hashes.py --record '{key}'`"
+    )
     digest, fingerprint = trajectory_hash(env_id, policy_name)
     if digest == recorded[key]:
         return

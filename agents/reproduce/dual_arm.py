@@ -64,6 +64,8 @@ def _explain(cmap: CollisionMap, result: BoundaryResult, exhaustive: int | None)
     """Why boundary following and the exhaustive scan disagree on one case."""
     if result.delay is None:
         return f"boundary following failed: {result.reason}"
+    if exhaustive is None:
+        return "the exhaustive scan found no collision-free delay"
     occ = cmap.full()
     s1s, s2s = cmap.curve(exhaustive)
     touching = [
@@ -96,6 +98,8 @@ def paper_case(out_dir: pathlib.Path) -> dict[str, Any]:
     full = CollisionMap.from_tasks(traj1, traj2, N_LEVELS)
     exhaustive = schedules.exhaustive_min_delay(full)
     best = schedules.min_makespan(full)
+    assert result.delay is not None and result.departure is not None, result.reason
+    assert best is not None  # the paper case has a schedule
     delayed = schedules.delay_schedule(full, result.delay)
     sequential = schedules.sequential(full)
     d_delayed = schedule_distance(traj1, traj2, delayed.advances)
@@ -134,7 +138,7 @@ def _run_in_env(policy_name: str, seeds=(0,), task_mode: str = "paper") -> dict[
     import gymnasium as gym
 
     import motiongym  # noqa: F401
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
     from motiongym.baselines import make_policy
 
     env_id = "motiongym/DualArmCell-v0"
@@ -183,7 +187,7 @@ def _paper_figures(out_dir, cmap, result, t_und, d_und, t_del, d_del, best) -> N
 
 def study(n_pairs: int) -> dict[str, Any]:
     """Boundary following against the exhaustive scan on ``n_pairs`` colliding pairs."""
-    rows = []
+    rows: list[dict[str, Any]] = []
     seeds = [SEED0 + i for i in range(n_pairs)]
     in_env = {
         name: _run_in_env(name, seeds, "colliding")
@@ -202,8 +206,10 @@ def study(n_pairs: int) -> dict[str, Any]:
         bf_sched = (
             schedules.delay_schedule(full, result.delay) if result.delay is not None else None
         )
+        assert exhaustive is not None, f"pair {SEED0 + i}: no collision-free delay"
         ex_sched = schedules.delay_schedule(full, exhaustive)
-        row = {
+        assert best is not None
+        row: dict[str, Any] = {
             "seed": SEED0 + i,
             "bf_delay": result.delay,
             "exhaustive_delay": exhaustive,

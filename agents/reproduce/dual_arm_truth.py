@@ -10,6 +10,7 @@ motion bound (:func:`fine_collides`).
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
@@ -38,20 +39,20 @@ def fine_collides(traj1: task.Trajectory, traj2: task.Trajectory, delay: int) ->
     return bool((model.robot_distance(q1, q2) <= 0.0).any())
 
 
-def _timed(plan) -> tuple[object, float]:
+def _timed(plan) -> tuple[Any, float]:
     start = time.process_time()
     out = plan()
     return out, time.process_time() - start
 
 
-def study_pair(seed: int, n_levels: int = 100) -> dict[str, object]:
+def study_pair(seed: int, n_levels: int = 100) -> dict[str, Any]:
     """One pair: the truth, each method's delay and verdict, CPU times (s)."""
     traj1, traj2 = task.sample_pair(np.random.default_rng(seed), "colliding", in_motion=True)
     n1, n2 = traj1.n_samples, traj2.n_samples
     table, truth_s = _timed(lambda: step_table(traj1, traj2))
     free = free_delays(table, n1, n2)
     found = np.flatnonzero(free)
-    row: dict[str, object] = {"seed": seed, "truth": int(found[0]) if len(found) else None}
+    row: dict[str, Any] = {"seed": seed, "truth": int(found[0]) if len(found) else None}
     row["truth_s"] = truth_s
     plan, row["exact_s"] = _timed(lambda: exact_delay_search(traj1, traj2, n_levels))
     row["exact"], row["lower_map"], row["checked"] = plan.delay, plan.lower, plan.checked
@@ -77,14 +78,14 @@ def study_pair(seed: int, n_levels: int = 100) -> dict[str, object]:
 def _verdict(delay: int | None, truth: int | None, free: np.ndarray) -> str:
     if delay is None:
         return "failed" if truth is not None else "none exists"
-    if not free[delay]:
+    if not free[delay] or truth is None:  # (no truth: no delay is free)
         return "early"  # collides on the v1 check
     return "equal" if delay == truth else f"late {delay - truth}"
 
 
-def summarise(rows: list[dict[str, object]]) -> dict[str, object]:
+def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Counts per method: equal, early, late (by how much), failed; CPU times."""
-    summary: dict[str, object] = {"pairs": len(rows), "rows": rows}
+    summary: dict[str, Any] = {"pairs": len(rows), "rows": rows}
     for key in METHODS:
         verdicts = [str(r[f"{key}_verdict"]) for r in rows]
         times = [float(r[f"{key}_s"]) for r in rows]
@@ -103,14 +104,14 @@ def summarise(rows: list[dict[str, object]]) -> dict[str, object]:
     return summary
 
 
-def truth_study(seeds: list[int], n_levels: int = 100) -> dict[str, object]:
+def truth_study(seeds: list[int], n_levels: int = 100) -> dict[str, Any]:
     """Every method against the truth on the pairs of ``seeds``; the at-rest pairs."""
     summary = summarise([study_pair(seed, n_levels) for seed in seeds])
     summary["at_rest"] = at_rest_study()
     return summary
 
 
-def resolution_study(truth: dict[str, object], levels=(50, 100, 200, 400)) -> dict[int, dict]:
+def resolution_study(truth: dict[str, Any], levels=(50, 100, 200, 400)) -> dict[int, dict]:
     """The exact search at each ``N_l`` on the truth study's pairs: delay error against
     the truth, how often the lower map's delay is the truth itself, delays checked,
     CPU time."""
@@ -152,7 +153,7 @@ def at_rest_pair(where: str) -> tuple[task.Trajectory, task.Trajectory]:
     )
 
 
-def at_rest_study() -> dict[str, object]:
+def at_rest_study() -> dict[str, Any]:
     """What the planner answers on the two at-rest pairs (a reason, never a delay)."""
     out = {}
     for where in ("start", "end"):
@@ -165,7 +166,7 @@ def _spread(late: list[int]) -> str:
     return f"{len(late)}: {min(late)}-{max(late)}, median {np.median(late):g}" if late else "0"
 
 
-def print_truth_study(summary: dict[str, object], resolution: dict[int, dict] | None) -> None:
+def print_truth_study(summary: dict[str, Any], resolution: dict[int, dict] | None) -> None:
     """The study's tables: each method against the brute force; the resolution."""
     from rich.console import Console
     from rich.table import Table

@@ -17,14 +17,14 @@ final poses (Fig. 5). It gives no other numbers. We run:
 3. Newton-Raphson beside Levenberg-Marquardt near the arm's singularity
    (stick almost in line with the boom); IK on unreachable targets: the
    reasons given, and that none is reported as converged;
-4. issue 16's IK probes: its flipped-bucket target, and 3,000 targets
+4. IK probes: a flipped-bucket target, and 3,000 targets
    sampled in Cartesian space (the reasons; no "no solution" reason where
    the closed form has an in-limit solution; no wrong pose, both bucket axes,
    reported converged) (:mod:`.excavator_ik`);
 5. the dig-cycle scripted policy (the paper's announced next step) on seeded
    scenes of the dig world: bucket fill at the end of the dig, soil
    delivered, spill, pipe contacts, cycle time;
-6. issue 16's probes of the world (:mod:`.excavator_probes`): what each does now;
+6. probes of the world, run as a reviewer would (:mod:`.excavator_probes`);
 7. speed: IK solves per second, and env steps per second beside
    Gymnasium's ``Reacher-v5`` measured in the same run.
 """
@@ -46,7 +46,7 @@ from motiongym.envs.excavator.kinematics import link_frames
 from motiongym.envs.excavator.observation import layout
 
 DIG_IDS = ("motiongym/Excavator-v0", "motiongym/Excavator-v1")
-DELIVERED = 0.8  # m3 (loose in v1): the issue's target for one cycle
+DELIVERED = 0.8  # m3 (loose in v1): the target for one cycle
 V_NAMES = ("E(1,1)", "E(3,1)", "E(1,4)", "E(2,4)", "E(3,4)")
 
 
@@ -83,17 +83,17 @@ def paper_case() -> dict[str, Any]:
 def dig_cycles(n: int, env_id: str, first_seed: int = 0) -> dict[str, Any]:
     """The dig-cycle policy on ``n`` seeded scenes of ``env_id`` (seeds from ``first_seed``).
 
-    Episodes run through :func:`~motiongym.agents.evaluate.run_episode`; a
+    Episodes run through :func:`~motiongym.agents.evaluation.episodes.run_episode`; a
     hook times the policy, reads its public ``diagnostics()`` (the cut depth
     it chose) and the zone's marked depth from the observation, and counts
     the steps with a contact of each kind (ground, self: v1 only). A clean
-    delivery (the issue's target): at least :data:`DELIVERED` m3 in the
+    delivery (the cycle's target): at least :data:`DELIVERED` m3 in the
     truck with no contact at all (pipe, truck, ground but the cut, self).
     """
     import gymnasium as gym
 
     from motiongym.agents.environments import resolved_env_kwargs
-    from motiongym.agents.evaluate import run_episode
+    from motiongym.agents.evaluation.episodes import run_episode
     from motiongym.baselines.registry import make_policy
 
     env = gym.make(env_id)
@@ -182,7 +182,9 @@ def speed(n_steps: int) -> dict[str, float]:
         env = gym.make(env_id)
         env.reset(seed=0)
         rng = np.random.default_rng(0)
-        actions = rng.uniform(-1, 1, size=(n_steps, *env.action_space.shape)).astype(np.float32)
+        actions = rng.uniform(-1, 1, size=(n_steps, *(env.action_space.shape or ()))).astype(
+            np.float32
+        )
         runs[env_id] = (env, actions)
     seconds = dict.fromkeys(ids, 0.0)
     chunk = max(n_steps // 10, 1)
@@ -283,7 +285,7 @@ def _print(results: dict[str, Any]) -> None:
         )
     c = results["issue_case"]
     table.add_row(
-        "issue's flipped bucket: converged / reason / q2+q3+q4",
+        "flipped bucket: converged / reason / q2+q3+q4",
         f"{c['converged']} / {c['reason']} / {c['q2+q3+q4']:.3f} rad",
         "-",
     )

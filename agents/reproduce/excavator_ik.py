@@ -1,7 +1,7 @@
-"""IK studies of the excavator reproduction (paper 002, eq. 9-13; issue 16).
+"""IK studies of the excavator reproduction (paper 002, eq. 9-13).
 
 Random reachable poses from several starts, the arm near its singularity,
-unreachable targets, the issue's flipped bucket, and targets sampled in
+unreachable targets, a flipped-bucket target, and targets sampled in
 Cartesian space (reasons, convergence of the solvable, wrong poses on both
 bucket axes). Used by :mod:`.excavator`.
 """
@@ -29,7 +29,7 @@ def random_poses(n: int, seed: int = 0) -> dict[str, Any]:
     """IK on ``n`` reachable poses for several start/method choices."""
     rng = np.random.default_rng(seed)
     qs = rng.uniform(M.q_min, M.q_max, size=(n, 4))
-    variants = {
+    variants: dict[str, dict[str, Any]] = {
         "newton_rest": dict(method="newton", align=False),
         "newton_rest_aligned": dict(method="newton", align=True, align_bucket=True),
         "newton_rest_swing_aligned": dict(method="newton", align=True),
@@ -38,7 +38,9 @@ def random_poses(n: int, seed: int = 0) -> dict[str, Any]:
     }
     out = {}
     for name, v in variants.items():
-        reasons, iterations, wrong = collections.Counter(), [], 0
+        reasons: collections.Counter[str] = collections.Counter()
+        iterations: list[int] = []
+        wrong = 0
         start = time.perf_counter()
         for q in qs:
             h = forward(q, M)
@@ -86,7 +88,8 @@ def near_singular(n: int, seed: int = 2) -> dict[str, Any]:
         cases.append(q)
     out = {}
     for method in ("newton", "lm"):
-        reasons, iterations = collections.Counter(), []
+        reasons: collections.Counter[str] = collections.Counter()
+        iterations: list[int] = []
         for q in cases:
             h = forward(q, machine)
             q0 = np.array(machine.q_rest)
@@ -108,7 +111,8 @@ def near_singular(n: int, seed: int = 2) -> dict[str, Any]:
 def unreachable(n: int, seed: int = 1) -> dict[str, Any]:
     """Targets beyond reach (1-4 m past the boom+stick annulus) or inside it."""
     rng = np.random.default_rng(seed)
-    reasons, false_success = collections.Counter(), 0
+    reasons: collections.Counter[str] = collections.Counter()
+    false_success = 0
     for k in range(n):
         beta = rng.uniform(-math.pi, math.pi)
         azimuth = rng.uniform(-math.pi, math.pi)
@@ -159,13 +163,14 @@ def cartesian_ik(n: int, seed: int = 12) -> dict[str, Any]:
     starts = {
         "newton_rest": lambda tip, beta: nr.solve(tip, beta, M),
         "newton_rest_swing_aligned": lambda tip, beta: nr.solve(
-            tip, beta, M, q0=(swing_for_target(tip[0], tip[1], M), *M.q_rest[1:])
+            tip, beta, M, q0=np.array((swing_for_target(tip[0], tip[1], M), *M.q_rest[1:]))
         ),
         "fallback_chain": lambda tip, beta: solve_pose(tip, beta, M),
     }
     out: dict[str, Any] = {"n": n, "seed": seed, "with_in_limit_solution": int(sum(solvable))}
     for name, solver in starts.items():
-        reasons, wrong, denied = collections.Counter(), 0, 0
+        reasons: collections.Counter[str] = collections.Counter()
+        wrong, denied = 0, 0
         for (tip, beta), exists in zip(targets, solvable, strict=True):
             r = solver(tip, beta)
             reasons[r.reason] += 1
@@ -182,7 +187,8 @@ def cartesian_ik(n: int, seed: int = 12) -> dict[str, Any]:
 
 
 def issue_case() -> dict[str, Any]:
-    """The issue's flipped bucket: ``solve([-0.028, 0.09, -3.665], -0.078)`` from rest."""
+    """A flipped-bucket target (a review's case): ``solve([-0.028, 0.09, -3.665], -0.078)``
+    from rest."""
     tip, beta = np.array([-0.028, 0.09, -3.665]), -0.078
     r = nr.solve(tip, beta, M)
     return {

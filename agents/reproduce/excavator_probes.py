@@ -1,8 +1,8 @@
-"""The issue's probes of the excavator world, run as a reviewer would (issue 16).
+"""Probes of the excavator world, run as a reviewer would.
 
 Each probe drives the dig world directly (joint goals from the IK, tracked
 within the rate limits; or a constant rate) through
-:func:`~motiongym.agents.evaluate.run_episode` with a step limit, and a hook
+:func:`~motiongym.agents.evaluation.episodes.run_episode` with a step limit, and a hook
 records what the world did. Every probe returns its numbers and ``physical``,
 the verdict by the stated rule:
 
@@ -37,12 +37,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import Step, run_episode
 from motiongym.baselines.excavator import bucket_path as bp
 from motiongym.baselines.excavator.tracking import solve_pose, track
 from motiongym.baselines.policy import ScriptedPolicy
@@ -57,7 +58,12 @@ UNDERCARRIAGE = {"half_length": 2.25, "half_width": 1.5, "height": 0.92}
 REACHED = 2e-3  # rad
 
 
-def _make(env_id: str, **kwargs: Any) -> gym.Env:
+def _keep_info(info: dict[str, Any]) -> Callable[[Step], None]:
+    """A run_episode hook that keeps the last step's ``info`` in ``info``."""
+    return lambda step: info.update(step.info)
+
+
+def _make(env_id: str, **kwargs: Any) -> Any:
     """The environment on level ground (``slope=0`` where the ID draws a slope):
     each probe isolates one phenomenon, and its poses are set in the base frame."""
     if gym.spec(env_id).kwargs.get("slope"):
@@ -136,7 +142,7 @@ class _World:
 
         def hook(step) -> None:
             q = step.next_observation[layout("dig")["q"]]
-            _, _, pin, tip = arm_points(*q, self.m)
+            _, _, pin, tip = arm_points(q[0], q[1], q[2], q[3], self.m)
             world = env.unwrapped
             trace.append(
                 {
@@ -151,7 +157,7 @@ class _World:
             if heights["full"] is None and trace[-1]["fill"] >= self.m.bucket_capacity - 1e-9:
                 heights["full"] = np.array(world.world.terrain.h)
 
-        run_episode(env, policy, self.seed, hook=hook, options={"q0": np.asarray(q0)})
+        run_episode(env, policy, self.seed, hook=hook, options={"start": np.asarray(q0)})
         heights["end"] = np.array(env.unwrapped.world.terrain.h)
         env.close()
         return trace, heights
@@ -311,16 +317,14 @@ def pipe_beside_boom_plane(env_id: str, seeds=range(400)) -> dict[str, Any]:
     half = 0.5 * m.bucket_width
 
     def gap(q) -> float:  # our own edge-corner distance to the pipe's surface
-        return _edge_to_axis(arm_points(*q, m)[3], q[0], half, a, b) - radius
+        return _edge_to_axis(arm_points(q[0], q[1], q[2], q[3], m)[3], q[0], half, a, b) - radius
 
     away = max((1.0, -1.0), key=lambda sign: gap(result.q + [sign * 0.2 / r, 0, 0, 0]))
     for shift in (0.0, 0.2):  # the edge's corner inside, then outside the pipe
         q0 = result.q + [away * shift / r, 0.0, 0.0, 0.0]
         policy = JointGoals(*world.space, [q0], m, world.dt)
         info: dict[str, Any] = {}
-        run_episode(
-            env, policy, seed, hook=lambda step, i=info: i.update(step.info), options={"q0": q0}
-        )
+        run_episode(env, policy, seed, hook=_keep_info(info), options={"start": q0})
         corner.append(gap(q0))
         reported.append(
             {"clearance_m": float(info["pipe_clearance"]), "contact": bool(info["pipe_contact"])}
@@ -345,7 +349,7 @@ def bucket_in_tracks(env_id: str, n: int = 400, seed: int = 0) -> dict[str, Any]
     m = env.unwrapped.params.machine
     inside = under = reported = 0
     for q in rng.uniform(m.q_min, m.q_max, size=(n, 4)):
-        _, _, pin, tip = arm_points(*q, m)
+        _, _, pin, tip = arm_points(q[0], q[1], q[2], q[3], m)
         across = np.array([math.sin(q[0]), -math.cos(q[0]), 0.0]) * 0.5 * m.bucket_width
         points = [np.array(pin) + s * (np.array(tip) - pin) for s in np.linspace(0, 1, 16)]
         points += [p + sign * across for p in points for sign in (-1.0, 1.0)]
@@ -361,9 +365,7 @@ def bucket_in_tracks(env_id: str, n: int = 400, seed: int = 0) -> dict[str, Any]
         if hit:
             info: dict[str, Any] = {}
             policy = JointGoals(env.observation_space, env.action_space, [q], m, 0.1)
-            run_episode(
-                env, policy, seed, hook=lambda step, i=info: i.update(step.info), options={"q0": q}
-            )
+            run_episode(env, policy, seed, hook=_keep_info(info), options={"start": q})
             reported += bool(info.get("self_contact", 0.0))
         inside += hit
         under += below and not hit

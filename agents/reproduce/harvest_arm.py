@@ -49,13 +49,15 @@ import numpy as np
 from scipy.stats import binomtest
 
 import motiongym  # noqa: F401  (registers the IDs)
-from motiongym.agents.evaluate import Step, run_episode
+from motiongym.agents.evaluation.episodes import Step, run_episode
+from motiongym.agents.evaluation.statistics import wilson_interval
 from motiongym.baselines.harvest_arm.policy import (
     ExtendedPotentialFieldPolicy,
     PotentialFieldPolicy,
     ResolvedRatePolicy,
 )
 from motiongym.envs.geometry import closest_point_on_segment
+from motiongym.envs.harvest_arm.observation import observation_views
 from motiongym.envs.harvest_arm.task import START_CLEARANCE, clearance_to_arm, solve_ik
 
 PAPER = {  # (mean m, std m, % below 0.03 m) per run, Tables 4-9
@@ -108,17 +110,21 @@ def _as_options(scene: Any) -> dict[str, Any]:
 
 def paired_scenes(kind: str, n: int) -> tuple[list[dict[str, Any]], int]:
     """The first ``n`` scenes valid for every arm of ``kind`` (reset options), and seeds drawn."""
-    envs = [gym.make(_env_id(kind), **_kwargs(kind, dof)).unwrapped for dof in DOFS[kind]]
-    scenes, seed = [], 0
+    envs: list[Any] = [  # the arms' own environments (scene, kinematics, link radius)
+        gym.make(_env_id(kind), **_kwargs(kind, dof)).unwrapped for dof in DOFS[kind]
+    ]
+    scenes: list[dict[str, Any]] = []
+    seed = 0
     while len(scenes) < n:
         envs[0].reset(seed=seed)
         scene = envs[0].scene
         seed += 1
         valid = True
         for env in envs[1:]:
-            kin, home = env.kinematics, np.array(env.spec_arm.home)
+            kin, home = env.world.kinematics, np.array(env.world.arm.home)
             start = kin.forward(home)
-            valid &= bool(clearance_to_arm(start, env.link_radius, scene).min() >= START_CLEARANCE)
+            radius = env.params.link_radius
+            valid &= bool(clearance_to_arm(start, radius, scene).min() >= START_CLEARANCE)
             valid = valid and solve_ik(kin, scene.fruit, home)[1] < 2e-3
         if valid:
             scenes.append(_as_options(scene))
@@ -129,14 +135,15 @@ class _Trial:
     """A run_episode hook: shortest distances, collisions and the poses of one trial."""
 
     def __init__(self, env: gym.Env, record: bool = False) -> None:
-        base = env.unwrapped
-        self.layout, self.link_radius, self.record = base.layout, base.link_radius, record
+        base: Any = env.unwrapped  # the arm's environment (its task's layout, link radius)
+        self.layout, self.record = base.task.layout, record
+        self.link_radius = base.params.link_radius
         self.axis = self.clearance = np.inf
         self.collision = self.self_collision = False
         self.poses: list[np.ndarray] = []
 
     def __call__(self, step: Step) -> None:
-        o = self.layout.parse(step.next_observation)
+        o = observation_views(self.layout, step.next_observation)
         axes = o["distances"] + self.link_radius + o["radius"][None, :]  # (L, K) centre lines
         self.axis = min(self.axis, float(axes[:, o["mask"]].min()))
         self.clearance = min(self.clearance, step.info["min_distance"])
@@ -180,7 +187,7 @@ def run_variant(kind: str, dof: int, variant: str, scenes: list[dict]) -> dict[s
         ):  # fmt: skip
             trials[key].append(value)
     seconds = time.perf_counter() - t0
-    out = {key: np.array(value) for key, value in trials.items()}
+    out: dict[str, Any] = {key: np.array(value) for key, value in trials.items()}
     out["ms_per_step"] = 1e3 * seconds / max(int(out["steps"].sum()), 1)
     return out
 
@@ -223,10 +230,7 @@ def _rates(t: dict[str, Any]) -> dict[str, float]:
 
 def _wilson(k: int, n: int, z: float = 1.96) -> list[float]:
     """Wilson 95 % interval of a proportion, in %."""
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return [100.0 * (centre - half), 100.0 * (centre + half)]
+    return [100.0 * bound for bound in wilson_interval(k, n, z)]
 
 
 def _ablation_tests(trials: dict[str, dict], full: dict) -> dict[str, dict]:

@@ -8,7 +8,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 
 MEASURE_OF = {  # the measure each ablated mechanism exists for
     "no eq. 8": "joint-to-path",
@@ -143,7 +143,7 @@ def _figure8(out_dir: pathlib.Path, plt: Any) -> str:
 
     trial = _Trial(env)
     run_episode(env, policy, seed=7, hook=hook)
-    scene = env.unwrapped.scene
+    scene = env.get_wrapper_attr("scene")
     fig = plt.figure(figsize=(6, 6))
     ax = fig.add_subplot(projection="3d")
     for a, b, bar in zip(scene.a, scene.b, scene.is_bar, strict=True):

@@ -44,7 +44,7 @@ import numpy as np
 
 import motiongym  # noqa: F401  (registers the IDs)
 from motiongym.agents.reproduce import sweeper_odometry, sweeper_report, sweeper_scale
-from motiongym.agents.sweeper_runs import run_sweep, sweeper_policy
+from motiongym.agents.reproduce.sweeper_runs import run_sweep, sweeper_policy
 from motiongym.baselines.sweeper.psa_cwa import (
     PsaCwaBfsTransferPolicy,
     PsaCwaPolicy,
@@ -68,7 +68,7 @@ def _env(**kwargs: Any) -> gym.Env:
     return gym.make(ENV_ID, robot_width=W, **kwargs)
 
 
-def _episode(env: gym.Env, policy: str, seed: int | None, options=None, max_steps=None) -> dict:
+def _episode(env: gym.Env, policy: str, seed: int, options=None, max_steps=None) -> dict:
     kwargs = {**gym.spec(ENV_ID).kwargs, "robot_width": W}
     out = run_sweep(env, sweeper_policy(policy, env, kwargs), seed, options, max_steps)
     out.pop("transfers")
@@ -77,7 +77,7 @@ def _episode(env: gym.Env, policy: str, seed: int | None, options=None, max_step
 
 def _bound(env: gym.Env) -> occupancy.SmartDfsBound:
     """The exploration bound of the episode just run (robot-scale cells anchored at its start)."""
-    sc = env.unwrapped.scenario
+    sc = env.get_wrapper_attr("scenario")
     return occupancy.smartdfs_bound(sc.reachable, W, sc.start)
 
 
@@ -328,7 +328,7 @@ def walls_turned_study(quick: bool) -> dict:
                 "travel_ratio": r["travel_ratio"],
                 "coverage": r["coverage"],
                 "left_to_cwa": 1.0 - r["psa_coverage"],
-                "reachable": env.unwrapped.state.n_reachable,
+                "reachable": env.get_wrapper_attr("state").n_reachable,
             }
         )
     return {
@@ -363,11 +363,12 @@ def weak_baseline_study(quick: bool) -> dict:
 
 def _map_pictures() -> dict[str, np.ndarray]:
     """Each shipped map's frame after a PSA + CWA run from seed 0 (the paper's Fig. 10, 13, 14)."""
-    pictures = {}
+    pictures: dict[str, np.ndarray] = {}
     for name in maps.SHIPPED_MAPS:
-        env = _env(map_name=name, render_mode="rgb_array", cell_pixels=6)
+        size = tuple(6 * n for n in maps.shipped_map(name).shape)  # 6 pixels per cell
+        env = _env(map_name=name, render_mode="rgb_array", render_size=size)
         _episode(env, "psa-cwa", 0)
-        pictures[name] = env.render()
+        pictures[name] = np.asarray(env.render())
         env.close()
     return pictures
 

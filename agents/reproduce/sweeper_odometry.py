@@ -1,4 +1,4 @@
-"""The sweeper's odometry table (paper 4.2, its open problem; issue 17).
+"""The sweeper's odometry table (paper 4.2, its open problem).
 
 PSA + CWA on ``Sweeper-v1`` (line-of-sight sensing) under heading noise
 (rad per action, a random walk of the heading), slip (relative std of a
@@ -7,7 +7,7 @@ and without it (:class:`~motiongym.baselines.sweeper.psa_cwa.PsaCwaDeadReckoning
 on the room, the apartment, the maze and procedural maps.
 
 Episodes run through the one episode loop
-(:func:`motiongym.agents.evaluate.run_episode`); its per-step hook reads the
+(:func:`motiongym.agents.evaluation.episodes.run_episode`); its per-step hook reads the
 policy's public ``diagnostics()["done"]`` and ends the episode at the step
 the policy declares the area swept, so the coverage recorded is the
 coverage at that moment: a premature stop shows as coverage below 100 %,
@@ -23,7 +23,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.baselines.sweeper.psa_cwa import PsaCwaDeadReckoningPolicy, PsaCwaPolicy
 
 ENV_ID = "motiongym/Sweeper-v1"
@@ -38,7 +38,7 @@ PROCEDURAL_SEED = 2000  # first seed of the procedural maps (the map is drawn fr
 
 def episode(map_name: str, heading: float, slip: float, seed: int, localise: bool) -> dict:
     """One episode; ``coverage`` at the step the policy declared itself done (or at the end)."""
-    kwargs = {"map_name": map_name, "heading_noise": heading, "slip_noise": slip}
+    kwargs: dict[str, Any] = {"map_name": map_name, "heading_noise": heading, "slip_noise": slip}
     env = gym.make(ENV_ID, **kwargs)
     cls = PsaCwaPolicy if localise else PsaCwaDeadReckoningPolicy
     policy = cls(env.observation_space, env.action_space, {**gym.spec(ENV_ID).kwargs, **kwargs})

@@ -1,9 +1,10 @@
-"""Start-position spread against the maze's size in robot widths (paper 4.1.2; issue 17).
+"""Start-position spread against the maze's size in robot widths (paper 4.1.2).
 
 The paper reports the travel from every start of its maze within about 3 %
 (max 20843, min 20193 base units) and gives neither the maze's size nor the
 robot's width in base units. Ours, on the shipped maze with ``W = 3``, spreads
-31 % (:func:`.sweeper.start_position_study`). This study asks what that
+far more (:func:`.sweeper.start_position_study`; docs/experiments/Sweeper-v0.md).
+This study asks what that
 relative figure depends on: the maze is enlarged ``k`` times (every cell
 becomes a ``k x k`` block, :func:`numpy.kron`; the layout is the same, only
 its size in robot widths grows) and PSA + CWA runs from the same number of
@@ -25,7 +26,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from motiongym.agents.sweeper_runs import run_sweep, sweeper_policy
+from motiongym.agents.reproduce.sweeper_runs import run_sweep, sweeper_policy
 from motiongym.envs.sweeper import maps, occupancy
 
 ENV_ID = "motiongym/Sweeper-v0"  # the reproduction's ID (travel needs no line of sight)

@@ -2,8 +2,8 @@
 
 Not the paper's method: a re-planning form of the minimum start delay, for a
 teacher whose labels are a function of the current state (DAgger,
-:mod:`motiongym.agents.dagger`) and for a learner-side view of the same
-table (:mod:`motiongym.agents.map_memory`, ``dual_arm_map``).
+:mod:`motiongym.agents.training.dagger`) and for a learner-side view of the same
+table (:mod:`motiongym.agents.learners.dual_arm`, ``dual_arm_map``).
 
 The step table (:func:`.exact_delay.step_table` on v1's check; on v0's,
 :func:`sample_table`) says for robot 1 on ``[s1, s1 + 1]`` and robot 2 on

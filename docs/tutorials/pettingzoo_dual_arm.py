@@ -32,10 +32,10 @@ from pathlib import Path
 from pettingzoo.test import parallel_api_test
 
 from motiongym.agents.environments import make_env
-from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
-from motiongym.agents.predictors import load_predictor, policy_label
-from motiongym.agents.report import comparison_table, console
-from motiongym.agents.train import train
+from motiongym.agents.evaluation.episodes import EVALUATION_SEED, evaluate
+from motiongym.agents.evaluation.report import comparison_table, console
+from motiongym.agents.models.predictors import load_predictor, policy_label
+from motiongym.agents.training.train import train
 from motiongym.envs.dual_arm import parallel_env
 
 ENV_ID = "motiongym/DualArmCell-v0"

@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 
 from motiongym.agents.environments import make_env
-from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.report import comparison_table, console
+from motiongym.agents.evaluation.episodes import EVALUATION_SEED, evaluate
+from motiongym.agents.evaluation.report import comparison_table, console
+from motiongym.agents.models.predictors import load_predictor
 from motiongym.baselines import ScriptedPolicy
 
 ENV_ID = "motiongym/DualArmCell-v0"

@@ -20,10 +20,10 @@ import argparse
 from pathlib import Path
 
 from motiongym.agents.environments import make_env
-from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
-from motiongym.agents.predictors import load_predictor, policy_label
-from motiongym.agents.report import comparison_table, console, write_comparison
-from motiongym.agents.train import train
+from motiongym.agents.evaluation.episodes import EVALUATION_SEED, evaluate
+from motiongym.agents.evaluation.report import comparison_table, console, write_comparison
+from motiongym.agents.models.predictors import load_predictor, policy_label
+from motiongym.agents.training.train import train
 
 ENV_ID = "motiongym/HarvestArmPlanar-v0"
 

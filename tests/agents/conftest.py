@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from motiongym.agents.ship import ship
-from motiongym.agents.train import train
+from motiongym.agents.models.ship import ship
+from motiongym.agents.training.train import train
 
 TINY_CONFIG = """
 ppo:

@@ -6,9 +6,9 @@ import pytest
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import evaluate
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.train import train
+from motiongym.agents.evaluation.episodes import evaluate
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.training.train import train
 
 # algorithm -> (ID, the block's algorithm-specific keys): on-policy, off-policy
 # (continuous and discrete actions) and recurrent families.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from motiongym.agents import benchmarks
+from motiongym.agents.evaluation import benchmarks
 
 ENV_ID = "motiongym/ExcavatorReach-v0"
 

@@ -13,8 +13,8 @@ import pytest
 import yaml
 
 from motiongym.agents.cli import main
-from motiongym.agents.config import default_config_path, load_config
-from motiongym.agents.train import train
+from motiongym.agents.training.config import default_config_path, load_config
+from motiongym.agents.training.train import train
 from motiongym.baselines import scripted_policies
 from motiongym.envs import ENV_IDS
 
@@ -202,7 +202,7 @@ def test_every_subcommand_has_help(argv, capsys):
 
 
 def test_train_defaults_to_the_config_files_first_block(tmp_path):
-    from motiongym.agents.config import first_block
+    from motiongym.agents.training.config import first_block
 
     config = tmp_path / "two.yml"
     config.write_text(

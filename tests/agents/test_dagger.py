@@ -1,4 +1,5 @@
-"""DAgger with a scripted teacher (motiongym.agents.dagger) and its train/ship route, by number."""
+"""DAgger with a scripted teacher (motiongym.agents.training.dagger) and its train/ship route,
+by number."""
 
 from __future__ import annotations
 
@@ -12,11 +13,11 @@ import yaml
 from stable_baselines3 import SAC
 from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-from motiongym.agents.dagger import dagger, on_policy_error
-from motiongym.agents.dataset import DATASET_SEED
 from motiongym.agents.errors import UsageError
-from motiongym.agents.features import ExcavatorFields
-from motiongym.agents.train import train
+from motiongym.agents.integrations.dataset import DATASET_SEED
+from motiongym.agents.learners.excavator import ExcavatorFields
+from motiongym.agents.training.dagger import dagger, on_policy_error
+from motiongym.agents.training.train import train
 from motiongym.baselines import make_policy
 
 REACH = "motiongym/ExcavatorReach-v1"
@@ -66,7 +67,7 @@ def test_a_dagger_run_teaches_without_rl_and_ships_with_its_kind(tmp_path):
     """``imitate`` in a block: iteration 0 is the teacher's (its success, no label error),
     then the learner's; no RL with n_timesteps 0; shipped as ``sac-dagger``, kind
     ``demonstrations``, and found by that name."""
-    from motiongym.agents.ship import ship
+    from motiongym.agents.models.ship import ship
 
     run_dir = train(REACH, "sac", _config(tmp_path), out_root=tmp_path / "runs", progress=False)
     record = json.loads((run_dir / "dagger.json").read_text())
@@ -86,7 +87,7 @@ def test_a_dagger_run_teaches_without_rl_and_ships_with_its_kind(tmp_path):
 
 def test_dagger_training_is_deterministic_from_its_seed(tmp_path):
     """Two runs of the same block and seed: the same figures and weights, bit for bit."""
-    from motiongym.agents.predictors import load_model
+    from motiongym.agents.models.predictors import load_model
 
     figures, weights = [], []
     env = gym.make(REACH)
@@ -252,9 +253,9 @@ def test_behaviour_cloning_fits_discrete_labels_by_cross_entropy():
     most likely action then agrees with most labels."""
     from sb3_contrib import MaskablePPO
 
-    from motiongym.agents.dagger import _rollout
-    from motiongym.agents.dataset import stack_steps
-    from motiongym.agents.imitation import behaviour_clone
+    from motiongym.agents.integrations.dataset import stack_steps
+    from motiongym.agents.training.dagger import _rollout
+    from motiongym.agents.training.imitation import behaviour_clone
 
     env = gym.make(SWEEPER, max_episode_steps=200)
     teacher = make_policy(
@@ -262,9 +263,9 @@ def test_behaviour_cloning_fits_discrete_labels_by_cross_entropy():
     )
     observations, labels, _, _ = _rollout(env, teacher, None, DATASET_SEED)
     block = SWEEPER_BLOCK["policy_kwargs"]
-    from motiongym.agents.features import FEATURES_EXTRACTORS
+    from motiongym.agents.learners import features_extractors
 
-    kwargs = {**block, "features_extractor_class": FEATURES_EXTRACTORS["sweeper_egocentric"]}
+    kwargs = {**block, "features_extractor_class": features_extractors()["sweeper_egocentric"]}
     model = MaskablePPO("MultiInputPolicy", env, policy_kwargs=kwargs, seed=0, device="cpu")
     data, actions = stack_steps(observations), np.asarray(labels)
     losses = behaviour_clone(model, data, actions, epochs=30, batch_size=64, seed=0)

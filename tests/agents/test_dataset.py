@@ -9,7 +9,7 @@ import pytest
 pytest.importorskip("minari")
 
 from motiongym.agents.cli import main  # noqa: E402
-from motiongym.agents.dataset import (  # noqa: E402
+from motiongym.agents.integrations.dataset import (  # noqa: E402
     DATASET_SEED,
     load_demonstrations,
     record_dataset,

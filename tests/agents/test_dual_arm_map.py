@@ -1,4 +1,4 @@
-"""The dual-arm learner-side lag map (motiongym.agents.dual_arm_map): what the learner is
+"""The dual-arm learner-side lag map (motiongym.agents.learners.dual_arm): what the learner is
 shown, checked against pure delays run in the environment; the predictor that rebuilds it
 at evaluation; its settings' errors; and its ablation at a small DAgger budget."""
 
@@ -11,9 +11,9 @@ import torch
 from dual_arm_runs import run_pure_delay
 from stable_baselines3 import SAC
 
-from motiongym.agents.dagger import dagger, on_policy_error
-from motiongym.agents.dual_arm_map import check_dual_arm_map_kwargs
-from motiongym.agents.map_memory import DualArmMapWrapper, MapMemoryPredictor
+from motiongym.agents.learners.dual_arm import DualArmMapWrapper, check_dual_arm_map_kwargs
+from motiongym.agents.learners.memory import MapMemoryPredictor
+from motiongym.agents.training.dagger import dagger, on_policy_error
 from motiongym.baselines import make_policy
 from motiongym.envs.core import ArgumentError
 from motiongym.envs.dual_arm.world import tasks_from_observation

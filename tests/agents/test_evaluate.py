@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import gymnasium as gym
 
-from motiongym.agents.evaluate import run_episode
+from motiongym.agents.evaluation.episodes import run_episode
 
 
 class Always:

@@ -9,10 +9,11 @@ import torch
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import evaluate
-from motiongym.agents.features import ExcavatorFields, SweeperEgocentric
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.train import train
+from motiongym.agents.evaluation.episodes import evaluate
+from motiongym.agents.learners.excavator import ExcavatorFields
+from motiongym.agents.learners.sweeper import SweeperEgocentric
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.training.train import train
 from motiongym.envs.excavator.observation import layout
 
 SWEEPER = "motiongym/Sweeper-v0"
@@ -141,8 +142,8 @@ def test_an_unknown_extractor_name_lists_the_known_ones(tmp_path):
         "  policy_kwargs: {features_extractor_class: NatureCNN}\n"
     )
     valid = (
-        "sweeper_egocentric, sweeper_map_pyramid, excavator_fields, harvest_obstacle_set, "
-        "goal_error"
+        "excavator_fields, goal_error, harvest_obstacle_set, sweeper_egocentric, "
+        "sweeper_map_pyramid"
     )
     with pytest.raises(UsageError, match=f"'NatureCNN' unknown; valid: {valid}"):
         train(SWEEPER, "ppo", config_path=config, out_root=tmp_path)

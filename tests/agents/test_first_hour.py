@@ -14,15 +14,15 @@ import torch
 
 from motiongym.agents.cli import build_parser, main
 from motiongym.agents.environments import make_env
-from motiongym.agents.evaluate import Evaluation, evaluate
-from motiongym.agents.predictors import RANDOM, available_policies, load_predictor
-from motiongym.agents.report import (
+from motiongym.agents.evaluation.episodes import Evaluation, evaluate
+from motiongym.agents.evaluation.report import (
     PIPED_WIDTH,
     _bar_errors,
     comparison_table,
     make_console,
     plotted_measures,
 )
+from motiongym.agents.models.predictors import RANDOM, available_policies, load_predictor
 from motiongym.envs import ENV_IDS
 
 SWEEPER = "motiongym/Sweeper-v0"
@@ -56,7 +56,7 @@ def test_evaluate_and_compare_share_a_folder_without_overwriting(capsys, tmp_pat
     evaluated = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     assert set(evaluated) == {f"Sweeper-v0_psa-cwa_evaluation.{x}" for x in ("json", "csv", "png")}
     out = capsys.readouterr().out
-    assert "± 95%" in out and "coverage (fraction)" in out
+    assert "95% interval" in out and "coverage (fraction)" in out
     argv = ["compare", SWEEPER, "--policies", "psa-cwa", RANDOM, *common, *room]
     assert main(argv) == 0
     for name, content in evaluated.items():  # compare wrote beside them, over none
@@ -101,11 +101,11 @@ def test_figures_omit_measures_always_zero_or_repeated_and_clip_rates():
     ]
     evaluations = [_evaluation("a", episodes), _evaluation("b", episodes[:1])]
     assert plotted_measures(evaluations) == ["return", "length", "is_success"]
-    errors = _bar_errors([0.9, 0.1, 0.5], [0.3, 0.3, 0.3], "rate")
-    np.testing.assert_allclose(errors, [[0.3, 0.1, 0.3], [0.1, 0.3, 0.3]])
-    errors = _bar_errors([2.0, -1.0], [3.0, 3.0], "m")  # a distance may be negative
+    errors = _bar_errors([0.9, 0.1], [0.6, 0.0], [1.0, 0.4], "rate")  # the summary's bounds
+    np.testing.assert_allclose(errors, [[0.3, 0.1], [0.1, 0.3]])
+    errors = _bar_errors([2.0, -1.0], [-1.0, -4.0], [5.0, 2.0], "m")  # may be negative
     np.testing.assert_allclose(errors, [[3.0, 3.0], [3.0, 3.0]])
-    np.testing.assert_allclose(_bar_errors([2.0], [3.0], "steps"), [[2.0], [3.0]])
+    np.testing.assert_allclose(_bar_errors([2.0], [-1.0], [5.0], "steps"), [[2.0], [3.0]])
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

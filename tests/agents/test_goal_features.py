@@ -1,4 +1,5 @@
-"""The goal_error features extractor of the goal IDs (motiongym.agents.features.GoalError)."""
+"""The goal_error features extractor of the goal IDs
+(motiongym.agents.learners.goal.GoalError)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 import torch
 
-from motiongym.agents.features import GoalError
+from motiongym.agents.learners.goal import GoalError
 from motiongym.envs.excavator.observation import layout
 
 GOAL = "motiongym/ExcavatorReachGoal-v1"

@@ -7,12 +7,12 @@ from pathlib import Path
 import pytest
 import yaml
 
-from motiongym.agents.config import default_config_path, load_config
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import evaluate
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.train import train
+from motiongym.agents.evaluation.episodes import evaluate
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.training.config import default_config_path, load_config
+from motiongym.agents.training.train import train
 
 GOAL_IDS = (
     "motiongym/HarvestArmGoal-v1",
@@ -75,7 +75,7 @@ def test_her_needs_learning_to_start_after_the_first_episode(tmp_path):
 def test_bad_her_and_residual_settings_are_named(change, message):
     path = default_config_path("motiongym/HarvestArmGoal-v1")
     block = {**load_config(path, "sac"), **change}
-    from motiongym.agents.config import validate_block
+    from motiongym.agents.training.config import validate_block
 
     with pytest.raises(UsageError, match=message):
         validate_block(block, "sac", "test")

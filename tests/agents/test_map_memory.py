@@ -1,4 +1,4 @@
-"""The sweeper's learner-side map memory (motiongym.agents.map_memory), checked against
+"""The sweeper's learner-side map memory (motiongym.agents.learners.sweeper), checked against
 the world's own state (the true map and sweep counts), not against the code that builds it."""
 
 from __future__ import annotations
@@ -8,15 +8,10 @@ import numpy as np
 import pytest
 import yaml
 
-from motiongym.agents.config import validate_block
 from motiongym.agents.errors import UsageError
-from motiongym.agents.map_memory import (
-    MEMORY_KEY,
-    MapMemoryPredictor,
-    MapMemoryWrapper,
-    SweeperMapMemory,
-    check_memory_kwargs,
-)
+from motiongym.agents.learners.memory import MapMemoryPredictor, check_memory_kwargs
+from motiongym.agents.learners.sweeper import MEMORY_KEY, MapMemoryWrapper, SweeperMapMemory
+from motiongym.agents.training.config import validate_block
 from motiongym.baselines import make_policy
 from motiongym.baselines.sweeper.belief import FREE, OBSTACLE
 from motiongym.envs.core import ArgumentError
@@ -224,9 +219,9 @@ def test_a_run_with_the_memory_trains_loads_and_evaluates(tmp_path):
     """A tiny DAgger run with the memory: its config names it, the loaded model acts in
     the bare environment (the loader adds the memory), and a model loaded without it
     is refused by name (its observation space lacks the entry)."""
-    from motiongym.agents.evaluate import evaluate
-    from motiongym.agents.predictors import load_predictor
-    from motiongym.agents.train import train
+    from motiongym.agents.evaluation.episodes import evaluate
+    from motiongym.agents.models.predictors import load_predictor
+    from motiongym.agents.training.train import train
 
     path = tmp_path / "memory.yml"
     path.write_text(yaml.safe_dump({"maskableppo": MEMORY_BLOCK}))

@@ -20,9 +20,9 @@ from zip_members import rewrite_zip
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.model_files import NORMALIZATION_FILE
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.pretrained import pretrained_models, write_manifest
+from motiongym.agents.models.files import NORMALIZATION_FILE
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.models.pretrained import pretrained_models, write_manifest
 
 ENV_ID = "motiongym/HarvestArm-v0"
 

@@ -8,15 +8,15 @@ import yaml
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import evaluate
-from motiongym.agents.multiagent import (
+from motiongym.agents.evaluation.episodes import evaluate
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.training.multiagent import (
     SharedPolicyPredictor,
     SharedPolicyVecEnv,
     parallel_factory,
     slot_observations,
 )
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.train import train
+from motiongym.agents.training.train import train
 
 DUAL_ARM = "motiongym/DualArmCell-v0"
 OBS = 94  # the cell's observation

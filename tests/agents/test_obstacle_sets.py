@@ -8,11 +8,12 @@ import pytest
 import torch
 
 from motiongym.agents.environments import make_env
-from motiongym.agents.evaluate import evaluate
-from motiongym.agents.obstacle_sets import HarvestObstacleSet, closest_points
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.train import train
+from motiongym.agents.evaluation.episodes import evaluate
+from motiongym.agents.learners.harvest_arm import HarvestObstacleSet, closest_points
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.training.train import train
 from motiongym.envs.geometry import closest_points_between_segments
+from motiongym.envs.harvest_arm.observation import observation_views, obstacle_width, point_count
 
 VARIANTS = [("motiongym/HarvestArmPlanar-v0", {"planar": True}), ("motiongym/HarvestArm-v0", {})]
 
@@ -30,6 +31,14 @@ def _batch(env_id: str, seeds=range(4), steps: int = 5) -> tuple[gym.Env, torch.
     return env, torch.as_tensor(np.stack(rows))
 
 
+def _sizes(env: gym.Env) -> tuple[dict[str, slice], int, int, int, int]:
+    """The environment's slices, obstacle slots K, links L, slot width and dim."""
+    base = env.unwrapped
+    dim = base.world.dim
+    slots, links = base.params.n_obstacles, point_count(base.world.arm) - 1
+    return base.task.layout.slices, slots, links, obstacle_width(dim), dim
+
+
 @pytest.mark.parametrize(("env_id", "kwargs"), VARIANTS)
 def test_the_parse_is_the_environments_layout_by_name(env_id, kwargs):
     env, obs = _batch(env_id)
@@ -37,7 +46,7 @@ def test_the_parse_is_the_environments_layout_by_name(env_id, kwargs):
     assert extractor(obs).shape == (4, 16)
     parsed = extractor.parse(obs)
     for i, row in enumerate(obs.numpy()):
-        truth = env.unwrapped.layout.parse(row)  # the environment's own parser
+        truth = observation_views(env.unwrapped.task.layout, row)  # the environment's own
         for key in ("points", "fruit_error", "a", "b", "radius", "distances"):
             np.testing.assert_allclose(parsed[key][i].numpy(), truth[key], atol=1e-6)
         np.testing.assert_array_equal(parsed["mask"][i].numpy() > 0.5, truth["mask"])
@@ -85,8 +94,7 @@ def test_the_features_do_not_depend_on_the_obstacles_slot_order(env_id, kwargs):
     env, obs = _batch(env_id)
     torch.manual_seed(0)
     extractor = HarvestObstacleSet(env.observation_space, **kwargs)
-    s, lay = env.unwrapped.layout.slices, env.unwrapped.layout
-    K, L, w = lay.n_slots, lay.n_links, lay.obstacle_width
+    s, K, L, w, _ = _sizes(env)
     order = torch.as_tensor(np.random.default_rng(1).permutation(K))
     permuted = obs.clone()
     permuted[:, s["obstacles"]] = obs[:, s["obstacles"]].reshape(-1, K, w)[:, order].flatten(1)
@@ -100,16 +108,16 @@ def test_the_features_do_not_depend_on_the_obstacles_slot_order(env_id, kwargs):
     assert not torch.allclose(extractor(moved), extractor(obs))
 
 
-def _turned(obs: torch.Tensor, layout, angle: float) -> torch.Tensor:
+def _turned(obs: torch.Tensor, env: gym.Env, angle: float) -> torch.Tensor:
     """The observation of the same scene and arm turned by ``angle`` about z (q_0 + angle)."""
-    s, d = layout.slices, layout.dim
+    s, K, _, _, d = _sizes(env)
     c, sn = np.cos(angle), np.sin(angle)
     turn = torch.eye(d, dtype=obs.dtype)
     turn[:2, :2] = torch.tensor([[c, -sn], [sn, c]])
     out = obs.clone()
     for name in ("points", "fruit", "fruit_error"):
         out[:, s[name]] = (obs[:, s[name]].reshape(len(obs), -1, d) @ turn.T).flatten(1)
-    rows = obs[:, s["obstacles"]].reshape(len(obs), layout.n_slots, -1).clone()
+    rows = obs[:, s["obstacles"]].reshape(len(obs), K, -1).clone()
     rows[..., :d] = rows[..., :d] @ turn.T
     rows[..., d : 2 * d] = rows[..., d : 2 * d] @ turn.T
     out[:, s["obstacles"]] = rows.flatten(1)
@@ -122,13 +130,14 @@ def _turned(obs: torch.Tensor, layout, angle: float) -> torch.Tensor:
 def test_in_the_waist_frame_a_scene_turned_with_the_arm_is_the_same_input(env_id, kwargs):
     env, obs = _batch(env_id)
     obs = obs.double()
-    turned = _turned(obs, env.unwrapped.layout, 0.7)
+    turned = _turned(obs, env, 0.7)
     # The turned observation is the environment's own: same clearances, same layout.
-    q = np.arctan2(*(turned[0, env.unwrapped.layout.slices[k]].numpy() for k in ("sin_q", "cos_q")))
+    s = _sizes(env)[0]
+    q = np.arctan2(*(turned[0, s[k]].numpy() for k in ("sin_q", "cos_q")))
     env.unwrapped.world.pose(q)
     np.testing.assert_allclose(
         env.unwrapped.world.points.ravel(),
-        turned[0, env.unwrapped.layout.slices["points"]].numpy(),
+        turned[0, s["points"]].numpy(),
         atol=1e-6,
     )
     torch.manual_seed(0)
@@ -141,13 +150,13 @@ def test_in_the_waist_frame_a_scene_turned_with_the_arm_is_the_same_input(env_id
 def test_empty_slots_do_not_count():
     env, obs = _batch("motiongym/HarvestArmPlanar-v0")
     extractor = HarvestObstacleSet(env.observation_space, planar=True)
-    s, lay = env.unwrapped.layout.slices, env.unwrapped.layout
+    s, K, _, w, _ = _sizes(env)
     emptied = obs.clone()
     emptied[:, s["mask"].start + 2] = 0.0  # slot 2 empty ...
     garbage = emptied.clone()  # ... whatever its row and clearances read
-    row = s["obstacles"].start + 2 * lay.obstacle_width
-    garbage[:, row : row + lay.obstacle_width] = 0.7
-    garbage[:, s["distances"]][:, 2 :: lay.n_slots] = 0.01
+    row = s["obstacles"].start + 2 * w
+    garbage[:, row : row + w] = 0.7
+    garbage[:, s["distances"]][:, 2::K] = 0.01
     torch.testing.assert_close(extractor(garbage), extractor(emptied))
     assert not torch.allclose(extractor(emptied), extractor(obs))
     none = obs.clone()

@@ -10,10 +10,10 @@ import pytest
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import EVALUATION_SEED, evaluate
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.pretrained import pretrained_models, verify_manifest
-from motiongym.agents.ship import ship
+from motiongym.agents.evaluation.episodes import EVALUATION_SEED, evaluate
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.models.pretrained import pretrained_models, verify_manifest
+from motiongym.agents.models.ship import ship
 from motiongym.envs import ENV_IDS
 
 SHIPPED = [(env_id, name) for env_id in ENV_IDS for name in pretrained_models(env_id)]
@@ -87,7 +87,7 @@ def test_ship_refuses_runs_of_different_ids(shipped_folder, tmp_path):
 
 
 def test_ship_keeps_a_better_shipped_model_unless_forced(shipped_folder, tmp_path, capsys):
-    """A temporary copy of a shipped folder stands for agents/pretrained: the worse
+    """A temporary copy of a shipped folder stands for agents/models/pretrained: the worse
     training run is refused with both scores, --force replaces, an equal run ships."""
     from motiongym.agents.cli import main
 

@@ -19,8 +19,12 @@ import yaml
 
 from motiongym.agents.cli import main
 from motiongym.agents.errors import UsageError
-from motiongym.agents.rllib_runs import SECTIONS, default_rllib_config, load_rllib_settings
-from motiongym.agents.sweep import final_evaluation, ship_groups, trial_specs
+from motiongym.agents.integrations.rllib_runs import (
+    SECTIONS,
+    default_rllib_config,
+    load_rllib_settings,
+)
+from motiongym.agents.integrations.sweep import final_evaluation, ship_groups, trial_specs
 from motiongym.envs import ENV_IDS
 
 try:
@@ -119,7 +123,7 @@ def test_bad_rllib_settings_are_refused_by_name(tmp_path):
 
 @needs_ray
 def test_every_id_gets_an_rllib_ppo_config_and_an_unknown_keyword_is_named():
-    from motiongym.agents.rllib_runs import ppo_config
+    from motiongym.agents.integrations.rllib_runs import ppo_config
 
     for env_id in ENV_IDS:
         config = ppo_config(env_id, load_rllib_settings(env_id))
@@ -143,7 +147,7 @@ def local_ray():
 def test_a_tiny_sweep_on_a_local_ray_writes_run_folders_and_ship_commands(
     tmp_path, local_ray, tiny_config
 ):
-    from motiongym.agents.sweep import SWEEP_FILE, sweep
+    from motiongym.agents.integrations.sweep import SWEEP_FILE, sweep
 
     specs = trial_specs(["motiongym/ExcavatorReach-v0"], [tiny_config], [0, 1], tmp_path / "out")
     groups = sweep(specs, tmp_path / "out")
@@ -164,7 +168,7 @@ def test_a_tiny_sweep_on_a_local_ray_writes_run_folders_and_ship_commands(
     [(env_id, False) for env_id in ENV_IDS] + [("motiongym/DualArmCell-v0", True)],
 )  # every ID with RLlib's PPO, the dual-arm cell also as RLlib multi-agent
 def test_one_tiny_rllib_iteration(tmp_path, local_ray, env_id, multi_agent):
-    from motiongym.agents.rllib_runs import train_rllib
+    from motiongym.agents.integrations.rllib_runs import train_rllib
 
     run_dir = train_rllib(env_id, 1, tmp_path, overrides=TINY_RLLIB, multi_agent=multi_agent)
     (progress,) = json.loads((run_dir / "progress.json").read_text())

@@ -6,7 +6,7 @@ import pytest
 from PIL import Image
 
 from motiongym.agents.cli import main
-from motiongym.agents.record import mp4_available, record
+from motiongym.agents.evaluation.record import mp4_available, record
 
 SWEEPER = "motiongym/Sweeper-v0"
 
@@ -44,7 +44,7 @@ def test_record_writes_an_mp4_with_the_same_frames(tmp_path, capsys):
 
 
 def test_record_without_ffmpeg_still_writes_the_gif_and_says_how(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr("motiongym.agents.record.mp4_available", lambda: False)
+    monkeypatch.setattr("motiongym.agents.evaluation.record.mp4_available", lambda: False)
     argv = ["record", SWEEPER, "--policy", "random", "--out", str(tmp_path)]
     assert main([*argv, "--env-kwargs", "max_episode_steps=3"]) == 0
     captured = capsys.readouterr()

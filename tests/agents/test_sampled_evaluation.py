@@ -9,13 +9,13 @@ import pytest
 import torch
 import yaml
 
-from motiongym.agents import benchmarks
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.evaluate import evaluate
-from motiongym.agents.predictors import SampledModel, load_predictor
-from motiongym.agents.pretrained import write_manifest
-from motiongym.agents.train import train
+from motiongym.agents.evaluation import benchmarks
+from motiongym.agents.evaluation.episodes import evaluate
+from motiongym.agents.models.predictors import SampledModel, load_predictor
+from motiongym.agents.models.pretrained import write_manifest
+from motiongym.agents.training.train import train
 
 SWEEPER = "motiongym/Sweeper-v0"
 TINY = (

@@ -10,7 +10,7 @@ import pytest
 import torch
 from stable_baselines3 import PPO, SAC
 
-from motiongym.agents.residual import ResidualPredictor, ResidualWrapper, zero_correction
+from motiongym.agents.training.residual import ResidualPredictor, ResidualWrapper, zero_correction
 from motiongym.baselines import make_policy
 
 REACH = "motiongym/ExcavatorReach-v1"
@@ -164,7 +164,7 @@ def test_a_correction_stalls_the_dig_cycle_only_below_its_goal_tolerance():
 )
 def test_bad_residual_blocks_are_refused_by_name(tmp_path, lines, message):
     from motiongym.agents.errors import UsageError
-    from motiongym.agents.train import train
+    from motiongym.agents.training.train import train
 
     config = tmp_path / "residual.yml"
     config.write_text("sac:\n  n_timesteps: 64\n  policy: MlpPolicy\n" + lines)
@@ -176,7 +176,11 @@ def test_bad_residual_blocks_are_refused_by_name(tmp_path, lines, message):
 @pytest.fixture(scope="module")
 def demonstrations(tmp_path_factory):
     pytest.importorskip("minari")
-    from motiongym.agents.dataset import load_demonstrations, record_dataset, transitions
+    from motiongym.agents.integrations.dataset import (
+        load_demonstrations,
+        record_dataset,
+        transitions,
+    )
 
     env_id = "motiongym/HarvestArmPlanarGoal-v1"
     path, _ = record_dataset(env_id, "potential-field", 2, tmp_path_factory.mktemp("ds"))
@@ -187,7 +191,7 @@ def demonstrations(tmp_path_factory):
 @pytest.mark.parametrize("algorithm", [SAC, PPO])
 def test_behaviour_cloning_fits_the_teacher(demonstrations, algorithm):
     """The cloned policy's actions on the teacher's states: at least 10x closer than before."""
-    from motiongym.agents.imitation import behaviour_clone
+    from motiongym.agents.training.imitation import behaviour_clone
 
     torch.manual_seed(0)
     env, (observations, actions), _ = demonstrations
@@ -206,11 +210,11 @@ def test_a_residual_run_trains_and_evaluates_with_its_scripted_policy(tmp_path):
     its model acts through ResidualPredictor (the scripted action plus the correction)."""
     from motiongym.agents.environments import make_env
     from motiongym.agents.errors import UsageError
-    from motiongym.agents.evaluate import evaluate
-    from motiongym.agents.predictors import load_predictor
-    from motiongym.agents.residual import ResidualPredictor
-    from motiongym.agents.ship import ship
-    from motiongym.agents.train import train
+    from motiongym.agents.evaluation.episodes import evaluate
+    from motiongym.agents.models.predictors import load_predictor
+    from motiongym.agents.models.ship import ship
+    from motiongym.agents.training.residual import ResidualPredictor
+    from motiongym.agents.training.train import train
 
     config = tmp_path / "residual.yml"
     config.write_text(
@@ -238,7 +242,7 @@ def test_a_run_with_demonstrations_clones_before_rl(demonstrations, tmp_path):
     import json
 
     from motiongym.agents.errors import UsageError
-    from motiongym.agents.train import train
+    from motiongym.agents.training.train import train
 
     _, _, path = demonstrations
     config = tmp_path / "bc.yml"
@@ -274,7 +278,7 @@ def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
     import yaml
 
     from motiongym.agents.errors import UsageError
-    from motiongym.agents.train import train
+    from motiongym.agents.training.train import train
 
     env_id = "motiongym/" + name.removesuffix("-residual")
     path = resources.files("motiongym.configs") / f"{name}.yml"
@@ -293,7 +297,7 @@ def test_shipped_residual_blocks_train_a_few_steps(name, tmp_path):
 
 
 def _shipped_residuals() -> list[tuple[str, str]]:
-    from motiongym.agents.pretrained import METRICS, pretrained_models
+    from motiongym.agents.models.pretrained import METRICS, pretrained_models
     from motiongym.envs import ENV_IDS
 
     return [
@@ -324,9 +328,9 @@ def test_a_shipped_residual_agent_without_its_correction_is_its_teacher(env_id, 
     import yaml
 
     from motiongym.agents.environments import make_env
-    from motiongym.agents.evaluate import evaluate
-    from motiongym.agents.predictors import load_predictor
-    from motiongym.agents.pretrained import METRICS, pretrained_models
+    from motiongym.agents.evaluation.episodes import evaluate
+    from motiongym.agents.models.predictors import load_predictor
+    from motiongym.agents.models.pretrained import METRICS, pretrained_models
 
     folder = pretrained_models(env_id)[name]
     metrics = json.loads((folder / METRICS).read_text())

@@ -7,7 +7,7 @@ import json
 import gymnasium as gym
 import pytest
 
-from motiongym.agents.throughput import (
+from motiongym.agents.bench.throughput import (
     PLANNERS,
     bench,
     markdown,

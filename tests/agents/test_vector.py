@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from motiongym.agents.errors import UsageError
-from motiongym.agents.train import train
-from motiongym.agents.vector import VectorEnvAdapter
+from motiongym.agents.training.train import train
+from motiongym.agents.training.vector import VectorEnvAdapter
 
 NATIVE_CONFIG = """
 ppo:

@@ -12,7 +12,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.predictors import NormalizedModel, load_predictor
+from motiongym.agents.models.predictors import NormalizedModel, load_predictor
 
 ENV_ID = "motiongym/HarvestArmPlanar-v0"
 ZOO_NAME = "motiongym-HarvestArmPlanar-v0"  # the zoo's EnvironmentName: '/' as '-'
@@ -57,7 +57,7 @@ def test_the_zoo_pickle_is_found_and_never_unpickled(tmp_path, env, monkeypatch,
 def test_the_zoo_statistics_converted_to_plain_arrays_are_applied(tmp_path, env):
     from pathlib import Path
 
-    from motiongym.agents.model_files import NORMALIZATION_FILE, save_normalization
+    from motiongym.agents.models.files import NORMALIZATION_FILE, save_normalization
 
     run = zoo_run(tmp_path, env, with_statistics=True)
     pickled = run / ZOO_NAME / "vecnormalize.pkl"
@@ -85,8 +85,8 @@ def test_the_zoo_files_are_made_from_configs_and_hold_only_keys_the_zoo_knows():
 
     from torch import nn
 
-    from motiongym.agents import zoo
-    from motiongym.agents.model_files import algorithm_classes
+    from motiongym.agents.integrations import zoo
+    from motiongym.agents.models.files import algorithm_classes
 
     folder = Path(__file__).parents[2] / "configs" / "zoo"
     assert sorted(p.stem for p in folder.glob("*.yml")) == sorted(zoo.ALGORITHMS)
@@ -105,7 +105,7 @@ def test_the_zoo_files_are_made_from_configs_and_hold_only_keys_the_zoo_knows():
 
 
 def test_zoo_blocks_convert_our_names():
-    from motiongym.agents.zoo import refusal, zoo_block
+    from motiongym.agents.integrations.zoo import refusal, zoo_block
 
     block, options = zoo_block(
         {"policy_kwargs": {"activation_fn": "tanh"}, "replay_buffer_class": "her",

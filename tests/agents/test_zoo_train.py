@@ -78,7 +78,7 @@ def zoo_train(algo: str, env_id: str, folder: Path) -> Path:
 @pytest.mark.parametrize(("algo", "env_id"), blocks())
 def test_the_zoo_trains_every_block_with_the_files_settings(tmp_path, algo, env_id):
     from motiongym.agents.environments import make_env
-    from motiongym.agents.model_files import algorithm_classes
+    from motiongym.agents.models.files import algorithm_classes
 
     block = yaml.safe_load((CONFIGS / f"{algo}.yml").read_text())[env_id]
     run = zoo_train(algo, env_id, tmp_path)
@@ -100,7 +100,7 @@ def test_motiongym_evaluates_a_zoo_run(tmp_path, capsys):
 
     from motiongym.agents.cli import main
     from motiongym.agents.environments import make_env
-    from motiongym.agents.model_files import NORMALIZATION_FILE, save_normalization
+    from motiongym.agents.models.files import NORMALIZATION_FILE, save_normalization
 
     env_id = "motiongym/HarvestArmPlanar-v0"
     run = zoo_train("ppo", env_id, tmp_path / "logs")

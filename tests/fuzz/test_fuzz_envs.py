@@ -80,6 +80,8 @@ def keyword_names(env_id: str) -> list[str]:
         for p in inspect.signature(env_class.__init__).parameters.values()
         if p.name not in ("self", "kwargs", "render_mode") and p.kind != p.VAR_KEYWORD
     ]
+    if not names and hasattr(env_class, "Params"):  # a core.SystemEnv: its dataclass
+        names = [f.name for f in dataclasses.fields(env_class.Params)]
     if not names:
         params = {"Sweeper": SweeperParams, "ExcavatorReach": ReachParams, "Excavator": DigParams}
         family = env_id.split("/")[1].rsplit("-", 1)[0]

@@ -34,11 +34,11 @@ from hypothesis import given
 from hypothesis import strategies as st
 from zip_members import rewrite_zip
 
-from motiongym.agents.config import RUN_SETTINGS, load_config
 from motiongym.agents.environments import make_env
 from motiongym.agents.errors import UsageError
-from motiongym.agents.predictors import load_predictor
-from motiongym.agents.pretrained import pretrained_models, write_manifest
+from motiongym.agents.models.predictors import load_predictor
+from motiongym.agents.models.pretrained import pretrained_models, write_manifest
+from motiongym.agents.training.config import RUN_SETTINGS, load_config
 
 ENV_ID = "motiongym/HarvestArm-v0"  # a shipped PPO model with normalisation statistics
 FILES = ("model.zip", "vecnormalize.npz", "config.yml", "manifest.json")

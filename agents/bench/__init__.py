@@ -1,0 +1,1 @@
+"""``motiongym bench``: throughput and memory as ratios against references timed in the same run."""
