@@ -21,11 +21,16 @@ install: $(STAMP)
 demo: $(STAMP)
 	MUJOCO_GL=egl $(BIN)/motiongym compare --all --episodes $(EPISODES) --out results/compare
 
+# Both tiers run on every core (pytest-xdist, one worker per core; PYTEST_WORKERS=0 runs in
+# one process). Each worker's libraries use one thread: two workers on two cores.
+PYTEST_WORKERS ?= auto
+PYTEST := MUJOCO_GL=egl OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 $(BIN)/pytest -q -n $(PYTEST_WORKERS)
+
 test: $(STAMP)
-	MUJOCO_GL=egl $(BIN)/pytest -q
+	$(PYTEST)
 
 test-slow: $(STAMP)
-	MUJOCO_GL=egl $(BIN)/pytest -q -m slow
+	$(PYTEST) -m slow
 
 # The full property-based hostile-input run (tests/fuzz: every ID's keywords, reset
 # options and actions, the PettingZoo env, the policies' predict, model folders, config

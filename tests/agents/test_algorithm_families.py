@@ -11,13 +11,24 @@ from motiongym.agents.models.predictors import load_predictor
 from motiongym.agents.training.train import train
 
 # algorithm -> (ID, the block's algorithm-specific keys): on-policy, off-policy
-# (continuous and discrete actions) and recurrent families.
+# (continuous and discrete actions) and recurrent families. The off-policy blocks set a
+# small replay buffer: SB3's default (a million transitions) takes most of a run this short
+# to allocate.
 FAMILIES = {
     "ppo": ("motiongym/ExcavatorReach-v0", "  n_steps: 32\n  batch_size: 32\n"),
     "a2c": ("motiongym/Sweeper-v0", "  n_steps: 8\n"),
-    "sac": ("motiongym/HarvestArmPlanar-v0", "  learning_starts: 16\n  batch_size: 16\n"),
-    "td3": ("motiongym/DualArmCell-v0", "  learning_starts: 16\n  batch_size: 16\n"),
-    "dqn": ("motiongym/Sweeper-v0", "  learning_starts: 16\n  batch_size: 16\n"),
+    "sac": (
+        "motiongym/HarvestArmPlanar-v0",
+        "  learning_starts: 16\n  batch_size: 16\n  buffer_size: 256\n",
+    ),
+    "td3": (
+        "motiongym/DualArmCell-v0",
+        "  learning_starts: 16\n  batch_size: 16\n  buffer_size: 256\n",
+    ),
+    "dqn": (
+        "motiongym/Sweeper-v0",
+        "  learning_starts: 16\n  batch_size: 16\n  buffer_size: 256\n",
+    ),
     "recurrentppo": ("motiongym/ExcavatorReach-v0", "  n_steps: 32\n  batch_size: 32\n"),
     "maskableppo": ("motiongym/Sweeper-v0", "  n_steps: 32\n  batch_size: 32\n"),
 }

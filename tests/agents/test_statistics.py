@@ -63,3 +63,12 @@ def test_tables_print_asymmetric_intervals_as_bounds():
     out = io.StringIO()
     make_console(out).print(summary_table(evaluation))
     assert "[0.01788, 0.4042]" in out.getvalue()
+
+
+def test_the_normal_quantile_constant_is_scipys():
+    """Z95 is written as a literal (scipy.stats is imported only for the t interval)."""
+    from scipy import stats
+
+    from motiongym.agents.evaluation.statistics import Z95
+
+    assert float(stats.norm.ppf(0.975)) == Z95

@@ -322,7 +322,9 @@ class _NoCorrection:
 @pytest.mark.parametrize(("env_id", "name"), _shipped_residuals())
 def test_a_shipped_residual_agent_without_its_correction_is_its_teacher(env_id, name):
     """The ablation of a shipped residual agent on its first three held-out episodes: with the
-    correction it repeats the episodes in metrics.json; switched off it repeats the scripted
+    correction it repeats the episodes in metrics.json (to 1e-4 relative: the network's float32
+    arithmetic is not bit-identical across CPUs, 5e-6 seen between the recording machine and
+    ours); switched off it repeats the scripted
     policy's episodes exactly (the difference between the two is the learned part's), the
     scripted policy made with the run's ``residual_kwargs``."""
     import yaml
@@ -340,7 +342,7 @@ def test_a_shipped_residual_agent_without_its_correction_is_its_teacher(env_id, 
     agent = load_predictor(name, env_id, env)
     on = evaluate(env, agent, seeds, env_id, name, progress=False).episodes
     for episode, recorded in zip(on, shipped["episodes"][:3], strict=True):
-        assert episode == pytest.approx(recorded, rel=1e-6)
+        assert episode == pytest.approx(recorded, rel=1e-4)
     config = yaml.safe_load((folder / "config.yml").read_text())
     teacher = make_policy(  # the scripted policy with the keywords it acted with in training
         env_id,

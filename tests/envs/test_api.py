@@ -131,8 +131,24 @@ def test_pickled_environment_continues_identically(env_id):
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_runs_in_spawned_subprocesses(env_id):
     # A spawned process has not imported motiongym: the "module:ID" form imports it.
-    venv = make_vec_env(
+    # Gymnasium's AsyncVectorEnv: its workers import gymnasium and motiongym only.
+    venv = gym.make_vec(
         f"motiongym:{env_id}",
+        num_envs=2,
+        vectorization_mode="async",
+        vector_kwargs={"context": "spawn"},
+    )
+    venv.reset(seed=0)
+    for _ in range(5):
+        venv.step(venv.action_space.sample())
+    venv.close()
+
+
+def test_runs_in_sb3_spawned_subprocesses():
+    # SB3's SubprocVecEnv (each worker imports SB3 and torch): one ID stands for all, the
+    # spawning itself is checked for every ID above.
+    venv = make_vec_env(
+        "motiongym:motiongym/DualArmCell-v1",
         n_envs=2,
         seed=0,
         vec_env_cls=SubprocVecEnv,
