@@ -45,6 +45,8 @@ def bound_clears(
     distances at the two ends; ``move1``, ``move2``: (..., 5) how far any point of each
     body moves (:func:`.motion.body_motion`). (...,) bool."""
     slack = move1[..., :, None] / 2 + move2[..., None, :] / 2
+    if slack.ndim == 2:  # one step (the world's): the same bound on scalars, faster
+        return np.bool_(min((d_start - slack).min(), (d_end - slack).min()) > margin)
     low = np.minimum((d_start - slack).min(axis=(-2, -1)), (d_end - slack).min(axis=(-2, -1)))
     return low > margin
 
@@ -70,15 +72,16 @@ def step_collides(
     slopes: tuple[np.ndarray, np.ndarray],
     start: tuple[float, float],
     end: tuple[float, float],
+    distance: float | None = None,
 ) -> bool:
     """One step's verdict under ``check`` (module docstring).
 
     ``d_start``, ``d_end``: (5, 5) link distances at the step's two ends;
     ``samples``: each arm's (N_r + 1, 6) samples; ``slopes``: their ``|dq|`` per
     sample (N_r, 6); ``start``, ``end``: each arm's progress (samples) at the
-    step's start and end.
+    step's start and end; ``distance``: ``d_end.min()`` where the caller has it.
     """
-    if float(d_end.min()) <= margin:
+    if (float(d_end.min()) if distance is None else distance) <= margin:
         return True
     if check == SAMPLES:
         return False

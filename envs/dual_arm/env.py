@@ -8,6 +8,7 @@ observation :data:`.task.LAYOUT`), the parameters :mod:`.params`.
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
 import numpy as np
@@ -17,6 +18,8 @@ from motiongym.envs.core import SystemEnv
 from motiongym.envs.dual_arm.params import CONTROLS, DualArmParams
 from motiongym.envs.dual_arm.task import DT, LAYOUT, DualArmTask
 from motiongym.envs.dual_arm.world import DualArmWorld
+
+_FLOAT32 = np.dtype(np.float32)
 
 
 class DualArmCellEnv(SystemEnv):
@@ -145,10 +148,15 @@ class DualArmCellEnv(SystemEnv):
     def make_task(self, params: DualArmParams) -> DualArmTask:
         return DualArmTask(params)
 
-    def check_action(self, action: Any) -> np.ndarray:
-        """The action as a finite float array of the space's shape (clipped by the world)."""
+    def check_action(self, action: Any) -> list[float]:
+        """The action as finite floats of the space's shape (clipped by the world), else a
+        ``ValueError`` naming the space."""
+        if type(action) is np.ndarray and action.dtype == _FLOAT32:  # the space's own type
+            values = action.tolist()
+            if action.shape == self.action_space.shape and math.isfinite(sum(values)):
+                return values
         meaning = f"advance per arm, control={self.params.control!r}"
-        return checked_box_action(action, self.action_space.shape, meaning)
+        return checked_box_action(action, self.action_space.shape, meaning).tolist()
 
 
 DualArmCellEnv.__doc__ = (DualArmCellEnv.__doc__ or "").replace(

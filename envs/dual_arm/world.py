@@ -84,10 +84,10 @@ class DualArmWorld(OwnsRenderer):
         """Put the task pair ``scene`` in place, both arms at their start (no noise)."""
         self.load(*scene)
 
-    def advance(self, action: np.ndarray) -> StepEvents:
-        """One step under a checked action (advances clipped into [0, 1]): both arms
-        move, and the step is checked on the world's ``check``."""
-        values = [min(max(v, 0.0), 1.0) for v in action.tolist()]
+    def advance(self, action: list[float]) -> StepEvents:
+        """One step under a checked action (finite floats, one per driven arm; clipped
+        into [0, 1] here): both arms move, and the step is checked on ``check``."""
+        values = [min(max(v, 0.0), 1.0) for v in action]
         a1, a2 = (values[0], values[1]) if self.control == "both" else (1.0, values[0])
         wait = (1.0 - a2) * DT if self.p2 < self.n2 else 0.0
         before = self.p1 / self.n1 + self.p2 / self.n2
@@ -95,7 +95,7 @@ class DualArmWorld(OwnsRenderer):
         self.move(a1, a2)
         collided = collision.step_collides(
             self.check, self.margin, d_start, self.distances, self.samples, self.slopes,
-            start, (self.p1, self.p2),
+            start, (self.p1, self.p2), self.distance,
         )  # fmt: skip
         return StepEvents(collided, before, wait)
 
