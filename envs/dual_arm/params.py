@@ -54,7 +54,10 @@ class DualArmParams:
     collision_check: str = "samples"
     render_size: tuple[int, int] = (480, 640)  # rows, columns of a frame
 
-    DEPRECATED: ClassVar[dict[str, Deprecated]] = {"task": Deprecated("pairs")}
+    # A bad value given under the old name is refused under that name.
+    DEPRECATED: ClassVar[dict[str, Deprecated]] = {
+        "task": Deprecated("pairs", lambda value, _: check_choice("task", value, PAIRS))
+    }
 
     def __post_init__(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731

@@ -409,7 +409,9 @@ class DualArmTask:
         lo, hi = observation_bounds()
         self.observation_space = spaces.Box(lo, hi, dtype=np.float32)
         self.options: dict[str, Any] = {"pairs": partial(check_choice, choices=PAIRS)}
-        self.deprecated_options = {"task": Deprecated("pairs")}
+        self.deprecated_options = {
+            "task": Deprecated("pairs", lambda v, _: check_choice("options['task']", v, PAIRS))
+        }
         self._wait2 = 0.0
         self._template = np.empty(LAYOUT.size, dtype=np.float32)
 

@@ -100,6 +100,7 @@ class DualArmWorld(OwnsRenderer):
         return StepEvents(collided, before, wait)
 
     def load(self, traj1: Trajectory, traj2: Trajectory) -> None:
+        """Put the pair in place (what :meth:`reset` does): both arms at sample 0."""
         self.tasks = (traj1, traj2)
         self.samples = (traj1.samples(), traj2.samples())  # (N_r + 1, 6) each
         self._deltas = tuple(np.diff(q, axis=0) for q in self.samples)  # (N_r, 6) each
