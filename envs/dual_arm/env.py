@@ -53,7 +53,8 @@ class DualArmCellEnv(SystemEnv):
 
     OBSERVATION_TABLE
 
-    Each task field is the arm's 4 x 6 via configurations (rad, its own
+    The bodies of ``distances``, in order: upper arm, forearm, wrist roll,
+    wrist bend, gripper. Each task field is the arm's 4 x 6 via configurations (rad, its own
     joints) then its 3 segment durations (s). From the tasks (40-93) a planner
     rebuilds both trajectories (``task.tasks_from_observation``) and the
     collision map.

@@ -342,8 +342,7 @@ LAYOUT = ObservationLayout(
             "distances",
             (5, 5),
             "m",
-            "d_ij (paper eq. 1), row i robot-1 body, column j robot-2 body; bodies upper "
-            "arm, forearm, wrist roll, wrist bend, gripper",
+            "d_ij (paper eq. 1), robot-1 body i, robot-2 body j, row major",
         ),
         ("task1", _TASK, "rad, s", "robot 1 via configurations (4 x 6), segment durations (3)"),
         ("task2", _TASK, "rad, s", "robot 2 via configurations (4 x 6), segment durations (3)"),
