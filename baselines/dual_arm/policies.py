@@ -83,7 +83,6 @@ class SchedulePolicy(ScriptedPolicy):
         self.n_levels = int(n_levels)
         # v1 checks the motion between samples: plan on the swept (conservative) map.
         self.safety_margin, self.check = environment_check(self.env_kwargs)
-        self.swept = self.check == collision.SWEPT
         self.margin = self.safety_margin + float(plan_margin)
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 
@@ -116,7 +115,7 @@ class SchedulePolicy(ScriptedPolicy):
         """Sequential operation on v0; on v1 the exact minimum pure delay, which exists
         whenever sequential operation is collision free (never sequential while a
         shorter pure delay would do)."""
-        if self.swept:
+        if self.check == collision.SWEPT:
             delay = exact_delay.true_min_delay(traj1, traj2, self.safety_margin)
             if delay is not None:
                 return schedules.delay_schedule(cmap, delay)
@@ -191,7 +190,7 @@ class BoundaryFollowingPolicy(SchedulePolicy):
         return np.array([a2], dtype=np.float32)
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
-        if self.swept:
+        if self.check == collision.SWEPT:
             traj1, traj2 = memory["tasks"]
             found = exact_delay_search(traj1, traj2, self.n_levels, memory["margin"])
             memory.update(result=found, fallback=found.delay is None, reason=found.reason)
@@ -211,7 +210,7 @@ class ExhaustiveDelayPolicy(SchedulePolicy):
     """Minimum start delay by scanning every delay on the full map."""
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
-        if self.swept:  # v1: the exact minimum on the environment's check, not on a map
+        if self.check == collision.SWEPT:  # v1: the exact minimum on its check, not a map
             traj1, traj2 = memory["tasks"]
             delay = exact_delay.true_min_delay(traj1, traj2, self.safety_margin)
         else:

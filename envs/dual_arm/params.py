@@ -39,6 +39,11 @@ WEIGHTS = ("time", "collision", "clearance", "advance")  # the reward terms, in 
 PAID = ("advance",)  # the terms added; the others are costs
 
 
+def _pairs_from_task(value: Any, current: Any) -> str:
+    """``pairs`` from its deprecated name ``task`` (a bad value refused under that name)."""
+    return check_choice("task", value, PAIRS)
+
+
 @dataclass(frozen=True)
 class DualArmParams:
     """The dual-arm cell's parameters (module docstring)."""
@@ -54,10 +59,7 @@ class DualArmParams:
     collision_check: str = "samples"
     render_size: tuple[int, int] = (480, 640)  # rows, columns of a frame
 
-    # A bad value given under the old name is refused under that name.
-    DEPRECATED: ClassVar[dict[str, Deprecated]] = {
-        "task": Deprecated("pairs", lambda value, _: check_choice("task", value, PAIRS))
-    }
+    DEPRECATED: ClassVar[dict[str, Deprecated]] = {"task": Deprecated("pairs", _pairs_from_task)}
 
     def __post_init__(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731

@@ -383,6 +383,11 @@ def tasks_from_observation(obs: np.ndarray) -> tuple[Trajectory, Trajectory]:
     return out[0], out[1]
 
 
+def _pairs_option_from_task(value: Any, current: Any) -> str:
+    """The ``pairs`` option from its deprecated name ``task`` (a bad value named as given)."""
+    return check_choice("options['task']", value, PAIRS)
+
+
 class StepEvents(NamedTuple):
     """What one step of the world did (:meth:`.world.DualArmWorld.advance`)."""
 
@@ -408,9 +413,7 @@ class DualArmTask:
         lo, hi = observation_bounds()
         self.observation_space = spaces.Box(lo, hi, dtype=np.float32)
         self.options: dict[str, Any] = {"pairs": partial(check_choice, choices=PAIRS)}
-        self.deprecated_options = {
-            "task": Deprecated("pairs", lambda v, _: check_choice("options['task']", v, PAIRS))
-        }
+        self.deprecated_options = {"task": Deprecated("pairs", _pairs_option_from_task)}
         self._wait2 = 0.0
         self._template = np.empty(LAYOUT.size, dtype=np.float32)
 
