@@ -46,7 +46,7 @@ def bound_clears(
     body moves (:func:`.motion.body_motion`). (...,) bool."""
     slack = move1[..., :, None] / 2 + move2[..., None, :] / 2
     if slack.ndim == 2:  # one step (the world's): the same bound on scalars, faster
-        return np.bool_(min((d_start - slack).min(), (d_end - slack).min()) > margin)
+        return np.asarray(min((d_start - slack).min(), (d_end - slack).min()) > margin)
     low = np.minimum((d_start - slack).min(axis=(-2, -1)), (d_end - slack).min(axis=(-2, -1)))
     return low > margin
 

@@ -157,7 +157,7 @@ class DualArmCellEnv(SystemEnv):
             if action.shape == self.action_space.shape and math.isfinite(sum(values)):
                 return values
         meaning = f"advance per arm, control={self.params.control!r}"
-        return checked_box_action(action, self.action_space.shape, meaning).tolist()
+        return checked_box_action(action, self.action_space.shape or (), meaning).tolist()
 
 
 DualArmCellEnv.__doc__ = (DualArmCellEnv.__doc__ or "").replace(

@@ -40,6 +40,7 @@ makes unsolvable by any start delay.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -404,26 +405,29 @@ class DualArmTask:
     ``pairs`` (:data:`PAIRS`; ``task`` its deprecated name).
     """
 
-    reward_terms = ("time", "collision", "clearance", "advance")
+    reward_terms: tuple[str, ...] = ("time", "collision", "clearance", "advance")
     layout = LAYOUT
 
     def __init__(self, params: DualArmParams) -> None:
         self.params = params
         self.weights = params.weights
         lo, hi = observation_bounds()
-        self.observation_space = spaces.Box(lo, hi, dtype=np.float32)
-        self.options: dict[str, Any] = {"pairs": partial(check_choice, choices=PAIRS)}
+        self.observation_space: spaces.Space = spaces.Box(lo, hi, dtype=np.float32)
+        self.options: Mapping[str, Callable[[str, Any], Any]] = {
+            "pairs": partial(check_choice, choices=PAIRS)
+        }
         self.deprecated_options = {"task": Deprecated("pairs", _pairs_option_from_task)}
         self._wait2 = 0.0
         self._template = np.empty(LAYOUT.size, dtype=np.float32)
 
-    def sample(self, rng: np.random.Generator, options: dict[str, Any]) -> tuple:
+    def sample(self, rng: np.random.Generator, options: Mapping[str, Any]) -> tuple:
         p = self.params
         mode = options.get("pairs", p.pairs)
         return sample_pair(rng, mode, p.safety_margin, check=p.collision_check)
 
     def begin(self, world: DualArmWorld) -> Outcome:
         self._wait2 = 0.0
+        assert world.tasks is not None  # the world was reset
         traj1, traj2 = world.tasks
         self._template = np.empty(LAYOUT.size, dtype=np.float32)  # the tasks part is fixed
         self._template[_TASKS] = np.concatenate([traj1.compact(), traj2.compact()])

@@ -66,7 +66,8 @@ class DualArmWorld(OwnsRenderer):
         self._renderer: mujoco.Renderer | None = None
         self._size: tuple[int, int] | None = None
         self.control, self.check, self.margin = control, check, float(margin)
-        self.action_space = spaces.Box(0.0, 1.0, (2 if control == "both" else 1,), np.float32)
+        n = 2 if control == "both" else 1
+        self.action_space: spaces.Space = spaces.Box(0.0, 1.0, (n,), np.float32)
         self.tasks: tuple[Trajectory, Trajectory] | None = None
         self._attach(model.MujocoCell())
 
@@ -103,8 +104,8 @@ class DualArmWorld(OwnsRenderer):
         """Put the pair in place (what :meth:`reset` does): both arms at sample 0."""
         self.tasks = (traj1, traj2)
         self.samples = (traj1.samples(), traj2.samples())  # (N_r + 1, 6) each
-        self._deltas = tuple(np.diff(q, axis=0) for q in self.samples)  # (N_r, 6) each
-        self.slopes = tuple(np.abs(d) for d in self._deltas)  # (N_r, 6) |dq| per sample
+        self._deltas = (np.diff(self.samples[0], axis=0), np.diff(self.samples[1], axis=0))
+        self.slopes = (np.abs(self._deltas[0]), np.abs(self._deltas[1]))  # (N_r, 6) |dq|
         self.n1, self.n2 = float(traj1.n_samples), float(traj2.n_samples)
         self.p1 = self.p2 = 0.0
         self.steps = 0
