@@ -210,3 +210,30 @@ def test_v1_colliding_pairs_run_one_after_the_other_without_contact_in_motion():
     u1, u2 = task.sample_pair(np.random.default_rng(50167), "colliding", check="swept")
     assert task.sequential_clear_in_motion(u1, u2)
     assert u1.duration != t1.duration or not np.array_equal(u1.vias, t1.vias)
+
+
+@pytest.mark.parametrize("env_id", [ID, "motiongym/DualArmCell-v1"])
+def test_the_world_and_the_planners_share_one_collision_rule(env_id):
+    """The environment's verdict on a schedule (robot 2 undelayed, then started when
+    robot 1 ends) is :func:`collision.schedule_collides` on the environment's check;
+    a check given as anything but its name is refused, naming ``check``."""
+    from motiongym.baselines.dual_arm.lag_map import LagMap
+    from motiongym.envs.dual_arm import collision, task
+
+    env = gym.make(env_id, control="robot_2", pairs="paper").unwrapped
+    check = env.params.collision_check
+    t1, t2 = task.paper_case()
+    for delay in (0, t1.n_samples):
+        advances = np.zeros(delay + t2.n_samples, dtype=np.int64)
+        advances[delay:] = 1
+        env.reset(seed=0)
+        collided = False
+        for a2 in advances:
+            _, _, terminated, _, info = env.step(np.array([float(a2)], np.float32))
+            collided |= info["collision"]
+            if terminated:
+                break
+        assert collided == collision.schedule_collides(check, t1, t2, advances)
+        assert collided == (delay == 0)
+    with pytest.raises(ValueError, match="check must be one of 'samples', 'swept', got True"):
+        LagMap(t1, t2, 0.0, True)
