@@ -237,3 +237,14 @@ def test_the_world_and_the_planners_share_one_collision_rule(env_id):
         assert collided == (delay == 0)
     with pytest.raises(ValueError, match="check must be one of 'samples', 'swept', got True"):
         LagMap(t1, t2, 0.0, True)
+
+
+def test_obs_is_the_deprecated_name_of_the_layout():
+    """``world.OBS`` / ``world.OBS_SIZE`` (the old dict of slices) still read, warning once."""
+    from motiongym.envs.checks import _warned
+    from motiongym.envs.dual_arm import world
+
+    _warned.discard(("motiongym.envs.dual_arm.world", "OBS"))
+    with pytest.warns(MotiongymDeprecationWarning, match="'OBS' is deprecated.*LAYOUT"):
+        assert world.OBS == LAYOUT.slices
+    assert world.OBS["progress"] == slice(12, 14) and world.OBS_SIZE == LAYOUT.size == 94
