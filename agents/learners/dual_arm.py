@@ -53,10 +53,11 @@ from gymnasium import spaces
 
 from motiongym.agents.learners.memory import MemoryWrapper
 from motiongym.baselines.dual_arm.lag_map import LagMap
-from motiongym.envs.core import ArgumentError, check_bool, check_int, check_keys
-from motiongym.envs.dual_arm.world import OBS, OBS_SIZE, tasks_from_observation
+from motiongym.envs.core import ArgumentError, check_bool, check_choice, check_int, check_keys
+from motiongym.envs.dual_arm.collision import CHECKS
+from motiongym.envs.dual_arm.task import LAYOUT, tasks_from_observation
 
-TASKS = slice(OBS["task1"].start, OBS["task2"].stop)
+TASKS = slice(LAYOUT["task1"].start, LAYOUT["task2"].stop)
 YIELDING = ("robot_2", "either")
 
 
@@ -104,14 +105,14 @@ class DualArmMapMemory:
 
     Args:
         margin: the environment's ``safety_margin`` (m).
-        swept: v1's check (True) or v0's (False).
+        check: the environment's ``collision_check`` (``"swept"``, v1, or ``"samples"``, v0).
         lags, bin_steps, bins, first_hit, yielding, sooner: the view
             (:func:`check_dual_arm_map_kwargs`).
     """
 
-    def __init__(self, margin: float, swept: bool, **kwargs: Any) -> None:
+    def __init__(self, margin: float, check: str, **kwargs: Any) -> None:
         settings = check_dual_arm_map_kwargs(kwargs)
-        self.margin, self.swept = float(margin), bool(swept)
+        self.margin, self.check = float(margin), check_choice("check", check, CHECKS)
         self.lags, self.bin_steps = settings["lags"], settings["bin_steps"]
         self.bins, self.first_hit = settings["bins"], settings["first_hit"]
         self.either = settings["yielding"] == "either"
@@ -125,9 +126,9 @@ class DualArmMapMemory:
     def for_env(cls, env: gym.Env, **kwargs: Any) -> DualArmMapMemory:
         """The memory for a dual-arm environment (its margin and check)."""
         params: Any = getattr(env.unwrapped, "params", None)
-        if env.observation_space.shape != (OBS_SIZE,) or not hasattr(params, "collision_check"):
+        if env.observation_space.shape != (LAYOUT.size,) or not hasattr(params, "collision_check"):
             raise ValueError(f"the dual_arm_map memory needs a dual-arm environment, got {env}")
-        return cls(params.safety_margin, params.collision_check == "swept", **kwargs)
+        return cls(params.safety_margin, params.collision_check, **kwargs)
 
     def space(self, observation_space: spaces.Space) -> spaces.Box:
         """What the learner sees: progress (2) and the lag map (flattened)."""
@@ -144,10 +145,10 @@ class DualArmMapMemory:
         if not self.maps or self.tasks is None or not np.array_equal(tasks, self.tasks):
             traj1, traj2 = tasks_from_observation(obs)
             orders = ((traj1, traj2), (traj2, traj1)) if self.either else ((traj1, traj2),)
-            self.maps = tuple(LagMap(a, b, self.margin, self.swept) for a, b in orders)
+            self.maps = tuple(LagMap(a, b, self.margin, self.check) for a, b in orders)
             self.tasks = tasks
         horizon = self.bins * self.bin_steps
-        parts: list[Any] = [obs[OBS["progress"]]]
+        parts: list[Any] = [obs[LAYOUT["progress"]]]
         states = [lag_map.state(obs) for lag_map in self.maps]
         if self.either:  # each robot's remaining samples (the first order: robot 1 runs)
             (x, p2), lag_map = states[0], self.maps[0]

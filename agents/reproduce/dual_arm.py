@@ -1,6 +1,6 @@
 """Reproduction of the dual-arm paper (time delay by boundary following), section IV.
 
-1. The paper case (our own pick-and-place pair, ``task="paper"``: the paper's
+1. The paper case (our own pick-and-place pair, ``pairs="paper"``: the paper's
    Fig. 6 trajectories are not in the text): the undelayed distance crossing
    zero (Fig. 7), the collision map with boundary following's trace and the
    departure point (Fig. 8-9), the delay found, the distance after the delay
@@ -142,7 +142,7 @@ def _run_in_env(policy_name: str, seeds=(0,), task_mode: str = "paper") -> dict[
     from motiongym.baselines import make_policy
 
     env_id = "motiongym/DualArmCell-v0"
-    env = gym.make(env_id, control="robot_2", task=task_mode)
+    env = gym.make(env_id, control="robot_2", pairs=task_mode)
     policy = make_policy(env_id, policy_name, env.observation_space, env.action_space, {})
     success, spans, min_d, replans = [], [], np.inf, 0
     for seed in seeds:

@@ -47,7 +47,7 @@ def _timed(plan) -> tuple[Any, float]:
 
 def study_pair(seed: int, n_levels: int = 100) -> dict[str, Any]:
     """One pair: the truth, each method's delay and verdict, CPU times (s)."""
-    traj1, traj2 = task.sample_pair(np.random.default_rng(seed), "colliding", in_motion=True)
+    traj1, traj2 = task.sample_pair(np.random.default_rng(seed), "colliding", check="swept")
     n1, n2 = traj1.n_samples, traj2.n_samples
     table, truth_s = _timed(lambda: step_table(traj1, traj2))
     free = free_delays(table, n1, n2)
@@ -121,7 +121,7 @@ def resolution_study(truth: dict[str, Any], levels=(50, 100, 200, 400)) -> dict[
         errors, tight, checked, times = [], [], [], []
         for row in rows:
             t1, t2 = task.sample_pair(
-                np.random.default_rng(row["seed"]), "colliding", in_motion=True
+                np.random.default_rng(row["seed"]), "colliding", check="swept"
             )
             plan, seconds = _timed(lambda t1=t1, t2=t2, n=n_levels: exact_delay_search(t1, t2, n))
             errors.append(plan.delay - row["truth"])

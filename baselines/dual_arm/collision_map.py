@@ -38,7 +38,9 @@ from collections.abc import Callable
 import numpy as np
 
 from motiongym.baselines.dual_arm.step_check import StepCheck
+from motiongym.envs.checks import check_choice
 from motiongym.envs.dual_arm import model
+from motiongym.envs.dual_arm.collision import CHECKS, SAMPLES, SWEPT
 from motiongym.envs.dual_arm.motion import body_motion, configs, spans_collide, variation
 from motiongym.envs.dual_arm.task import DT, Trajectory
 
@@ -83,12 +85,12 @@ class CollisionMap:
         traj2: Trajectory,
         n_levels: int = 100,
         margin: float = 0.0,
-        swept: bool = False,
+        check: str = SAMPLES,
     ) -> CollisionMap:
         """The map of two arms' tasks (the link geometry of ``envs.dual_arm.model``).
 
-        ``swept=False``: the paper's cells, one configuration each (robot 1 at
-        sample ``s1``, robot 2 at the level's floor). ``swept=True``: each
+        ``check="samples"`` (v0's check): the paper's cells, one configuration each (robot 1 at
+        sample ``s1``, robot 2 at the level's floor). ``check="swept"`` (v1's): each
         cell stands for a motion and is blocked when *any* configuration of it
         comes within ``margin`` (certified, :func:`motion.spans_collide`):
         robot 1 over its samples ``[s1, s1 + 1]``, robot 2 over the samples in
@@ -100,7 +102,7 @@ class CollisionMap:
         the union of the curve's cells in that column, so a delay whose curve
         is free on this map never collides, between samples included.
         """
-        if swept:
+        if check_choice("check", check, CHECKS) == SWEPT:
             return cls._swept(traj1, traj2, n_levels, margin)
         q1 = traj1.samples()  # (N1 + 1, 6)
         q2, tl, _ = traj2.length_parametrised(n_levels)  # (N_l + 1, 6), (N2 + 1,)

@@ -39,8 +39,9 @@ import numpy as np
 
 from motiongym.baselines.dual_arm.exact_delay import step_table
 from motiongym.baselines.dual_arm.step_check import StepCheck
-from motiongym.envs.dual_arm.task import Trajectory
-from motiongym.envs.dual_arm.world import OBS
+from motiongym.envs.checks import check_choice
+from motiongym.envs.dual_arm.collision import CHECKS, SWEPT
+from motiongym.envs.dual_arm.task import LAYOUT, Trajectory
 
 
 def sample_table(traj1: Trajectory, traj2: Trajectory, margin: float = 0.0) -> np.ndarray:
@@ -64,21 +65,23 @@ class LagMap:
         traj1, traj2: the two arms' trajectories, in either order: ``traj1``'s robot
             runs on, ``traj2``'s is the one that waits.
         margin: the environment's ``safety_margin`` (m).
-        swept: v1's check (the motion of each step) if True, v0's (the step's end) if False.
+        check: the environment's ``collision_check``: ``"swept"`` (v1, the motion of each
+            step) or ``"samples"`` (v0, the step's end).
     """
 
     def __init__(
-        self, traj1: Trajectory, traj2: Trajectory, margin: float = 0.0, swept: bool = True
+        self, traj1: Trajectory, traj2: Trajectory, margin: float = 0.0, check: str = SWEPT
     ) -> None:
         self.n1, self.n2 = traj1.n_samples, traj2.n_samples
         self.lead, self.wait = traj1.robot, traj2.robot
+        swept = check_choice("check", check, CHECKS) == SWEPT
         self.table = (step_table if swept else sample_table)(traj1, traj2, margin)
 
     def state(self, observation: np.ndarray) -> tuple[int, float]:
         """``(x, p2)`` from an observation's progress fields: the running robot's sample
         (rounded) and the waiting robot's samples run (to 1e-3: the float32 observation
         reads a whole sample as 244.000007)."""
-        progress = np.asarray(observation, dtype=float)[OBS["progress"]]
+        progress = np.asarray(observation, dtype=float)[LAYOUT["progress"]]
         x = int(round(progress[self.lead] * self.n1))
         return x, round(float(progress[self.wait] * self.n2), 3)
 

@@ -1,7 +1,7 @@
 """The dual-arm schedules as scripted policies acting from the observation.
 
 At an episode's first step each policy rebuilds both arms' trajectories from
-the tasks in the observation (``world.tasks_from_observation``), builds the
+the tasks in the observation (``task.tasks_from_observation``), builds the
 collision map (``N_l = 100`` by default, the environment's ``safety_margin``
 plus an optional ``plan_margin``) and plans robot 2's schedule; then each step
 it reads the step index from the observation's elapsed time and returns the
@@ -33,19 +33,20 @@ from motiongym.baselines.dual_arm.bracket import exact_delay_search
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.dual_arm.lag_map import LagMap
 from motiongym.baselines.policy import ScriptedPolicy
-from motiongym.envs.core import check_bool, params_from_kwargs
-from motiongym.envs.dual_arm.params import DualArmParams
-from motiongym.envs.dual_arm.task import DT
-from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
+from motiongym.envs.core import check_bool
+from motiongym.envs.dual_arm import collision
+from motiongym.envs.dual_arm.params import params_for
+from motiongym.envs.dual_arm.task import DT, LAYOUT, tasks_from_observation
+
+_ELAPSED = LAYOUT["elapsed"].start
 
 
-def environment_check(env_kwargs: dict[str, Any]) -> tuple[float, bool]:
-    """``(safety_margin, swept)`` of the environment made with ``env_kwargs``: its margin
-    (m) and whether it checks the motion between samples (v1) or the samples (v0)."""
-    params = params_from_kwargs(
-        DualArmParams, env_kwargs, ignore=("render_mode", "max_episode_steps")
-    )
-    return params.safety_margin, params.collision_check == "swept"
+def environment_check(env_kwargs: dict[str, Any]) -> tuple[float, str]:
+    """``(safety_margin, check)`` of the environment made with ``env_kwargs``: its margin
+    (m) and its ``collision_check`` (``"swept"``: the motion between samples, v1;
+    ``"samples"``: the samples, v0), the rule of :mod:`motiongym.envs.dual_arm.collision`."""
+    params = params_for(env_kwargs)
+    return params.safety_margin, params.collision_check
 
 
 class SchedulePolicy(ScriptedPolicy):
@@ -56,7 +57,8 @@ class SchedulePolicy(ScriptedPolicy):
         plan_margin: extra clearance (m) the planner demands beyond the
             environment's ``safety_margin``.
         verify: check the plan at the arms' actual samples
-            (``schedules.collides_at_samples``); where the map's length
+            (:func:`motiongym.envs.dual_arm.collision.schedule_collides` on the
+            environment's check); where the map's length
             discretisation hid a graze, plan again with the map's margin raised
             by ``replan_step`` (m), at most ``max_replans`` times, then fall back
             to sequential operation (v1: to the exact minimum pure delay). The
@@ -80,7 +82,7 @@ class SchedulePolicy(ScriptedPolicy):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
         # v1 checks the motion between samples: plan on the swept (conservative) map.
-        self.safety_margin, self.swept = environment_check(self.env_kwargs)
+        self.safety_margin, self.check = environment_check(self.env_kwargs)
         self.margin = self.safety_margin + float(plan_margin)
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 
@@ -95,15 +97,14 @@ class SchedulePolicy(ScriptedPolicy):
     def _plan_verified(self, traj1, traj2, memory: dict[str, Any]) -> schedules.Schedule:
         margin = self.margin
         for replans in range(self.max_replans + 1):
-            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, margin, self.swept)
+            cmap = CollisionMap.from_tasks(traj1, traj2, self.n_levels, margin, self.check)
             memory.update(margin=margin)
             plan = self.plan(cmap, memory)
             memory.update(map=cmap, replans=replans)
-            collides = schedules.collides_swept if self.swept else schedules.collides_at_samples
             if memory.get("reason"):  # no pure delay exists: nothing to re-plan
                 return plan
-            if not (self.verify and self.verifiable) or not collides(
-                traj1, traj2, plan.advances, self.safety_margin
+            if not (self.verify and self.verifiable) or not collision.schedule_collides(
+                self.check, traj1, traj2, plan.advances, self.safety_margin
             ):
                 return plan
             margin += self.replan_step
@@ -114,7 +115,7 @@ class SchedulePolicy(ScriptedPolicy):
         """Sequential operation on v0; on v1 the exact minimum pure delay, which exists
         whenever sequential operation is collision free (never sequential while a
         shorter pure delay would do)."""
-        if self.swept:
+        if self.check == collision.SWEPT:
             delay = exact_delay.true_min_delay(traj1, traj2, self.safety_margin)
             if delay is not None:
                 return schedules.delay_schedule(cmap, delay)
@@ -139,7 +140,7 @@ class SchedulePolicy(ScriptedPolicy):
             memory["tasks"] = tasks_from_observation(obs)
             traj1, traj2 = memory["tasks"]
             memory["schedule"] = self._plan_verified(traj1, traj2, memory)
-        step = int(round(float(obs[OBS["elapsed"]][0]) / DT))
+        step = int(round(float(obs[_ELAPSED]) / DT))
         adv = memory["schedule"].advances
         a2 = float(adv[step]) if step < len(adv) else 1.0
         if self.action_space.shape == (2,):
@@ -180,7 +181,7 @@ class BoundaryFollowingPolicy(SchedulePolicy):
         obs = np.asarray(observation, dtype=float)
         if memory["lag_map"] is None:
             traj1, traj2 = tasks_from_observation(obs)
-            memory["lag_map"] = LagMap(traj1, traj2, self.safety_margin, self.swept)
+            memory["lag_map"] = LagMap(traj1, traj2, self.safety_margin, self.check)
         lag_map = memory["lag_map"]
         x, p2 = lag_map.state(obs)
         a2 = 1.0 if lag_map.clear_now(x, p2) else 0.0
@@ -189,7 +190,7 @@ class BoundaryFollowingPolicy(SchedulePolicy):
         return np.array([a2], dtype=np.float32)
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
-        if self.swept:
+        if self.check == collision.SWEPT:
             traj1, traj2 = memory["tasks"]
             found = exact_delay_search(traj1, traj2, self.n_levels, memory["margin"])
             memory.update(result=found, fallback=found.delay is None, reason=found.reason)
@@ -209,7 +210,7 @@ class ExhaustiveDelayPolicy(SchedulePolicy):
     """Minimum start delay by scanning every delay on the full map."""
 
     def plan(self, cmap: CollisionMap, memory: dict[str, Any]) -> schedules.Schedule:
-        if self.swept:  # v1: the exact minimum on the environment's check, not on a map
+        if self.check == collision.SWEPT:  # v1: the exact minimum on its check, not a map
             traj1, traj2 = memory["tasks"]
             delay = exact_delay.true_min_delay(traj1, traj2, self.safety_margin)
         else:
@@ -267,7 +268,7 @@ class EitherWaitsPolicy(ScriptedPolicy):
                 f"either-waits moves both robots: it needs control='both' (an action of "
                 f"shape (2,)), got an action of shape {action_space.shape}"
             )
-        self.safety_margin, self.swept = environment_check(self.env_kwargs)
+        self.safety_margin, self.check = environment_check(self.env_kwargs)
 
     def new_memory(self) -> dict[str, Any]:
         return {"lag_maps": None, "yields": None}
@@ -277,8 +278,8 @@ class EitherWaitsPolicy(ScriptedPolicy):
         if memory["lag_maps"] is None:
             traj1, traj2 = tasks_from_observation(obs)
             memory["lag_maps"] = (
-                LagMap(traj1, traj2, self.safety_margin, self.swept),  # robot 2 yields
-                LagMap(traj2, traj1, self.safety_margin, self.swept),  # robot 1 yields
+                LagMap(traj1, traj2, self.safety_margin, self.check),  # robot 2 yields
+                LagMap(traj2, traj1, self.safety_margin, self.check),  # robot 1 yields
             )
         best = None  # (steps, yielding robot, wait)
         for lag_map in memory["lag_maps"]:

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
-from motiongym.envs.dual_arm import model, motion
+from motiongym.envs.dual_arm import collision
 from motiongym.envs.dual_arm.task import Trajectory
 
 
@@ -132,29 +132,21 @@ def _backtrack(
 
 def sample_indices(advances: np.ndarray, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray]:
     """Robot 1's and robot 2's sample index at every step of a schedule (incl. the start)."""
-    p2 = np.concatenate([[0], np.cumsum(advances)])
-    return np.minimum(np.arange(len(p2)), n1), np.minimum(p2, n2)
+    return collision.schedule_indices(advances, n1, n2)
 
 
 def collides_at_samples(
     traj1: Trajectory, traj2: Trajectory, advances: np.ndarray, margin: float = 0.0
 ) -> bool:
     """True iff ``d(R1, R2) <= margin`` at some step of the schedule, evaluated at the
-    arms' actual samples (what the environment sees), not at the map's length levels."""
-    p1, p2 = sample_indices(advances, traj1.n_samples, traj2.n_samples)
-    a1, b1 = model.link_segments(traj1.samples()[p1], model.base_transform(traj1.robot))
-    a2, b2 = model.link_segments(traj2.samples()[p2], model.base_transform(traj2.robot))
-    return bool(model.segments_collide(a1, b1, a2, b2, margin).any())
+    arms' actual samples (what the environment sees), not at the map's length levels:
+    :func:`motiongym.envs.dual_arm.collision.schedule_collides` on ``"samples"``."""
+    return collision.schedule_collides(collision.SAMPLES, traj1, traj2, advances, margin)
 
 
 def collides_swept(
     traj1: Trajectory, traj2: Trajectory, advances: np.ndarray, margin: float = 0.0
 ) -> bool:
     """True iff some step of the schedule, both arms moving at once, comes within
-    ``margin``: the v1 environment's check (:func:`motion.simultaneous_collide`)."""
-    p1, p2 = sample_indices(advances, traj1.n_samples, traj2.n_samples)
-    q1, q2 = traj1.samples(), traj2.samples()
-    for t in range(len(p1) - 1):
-        if motion.simultaneous_collide(q1, (p1[t], p1[t + 1]), q2, (p2[t], p2[t + 1]), margin):
-            return True
-    return False
+    ``margin``: :func:`motiongym.envs.dual_arm.collision.schedule_collides` on ``"swept"``."""
+    return collision.schedule_collides(collision.SWEPT, traj1, traj2, advances, margin)

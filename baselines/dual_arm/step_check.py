@@ -3,7 +3,7 @@
 ``DualArmCell-v1`` (``collision_check="swept"``) calls a step a collision when
 any instant of it, both arms moving at once on their straight joint-space
 moves between samples, comes within ``safety_margin``
-(:meth:`motiongym.envs.dual_arm.env.DualArmCellEnv._collides_between`, up to
+(:func:`motiongym.envs.dual_arm.collision.step_collides`, up to
 :data:`motion.RESOLUTION`). Robot 1 runs on its nominal schedule, so in step
 ``x`` it moves over its samples ``[x, x + 1]`` (at rest at ``N1`` once done:
 row ``min(x, N1)``); robot 2, at full speed or waiting, is in one of
@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from motiongym.envs.dual_arm import model, motion
+from motiongym.envs.dual_arm import collision, model, motion
 from motiongym.envs.dual_arm.task import Trajectory
 from motiongym.envs.geometry import closest_points_between_segments
 
@@ -119,8 +119,8 @@ class StepCheck:
         d_lo = self._bounded_distances(self.lo1[rows], self.lo2[cols], slack)
         d_hi = self._bounded_distances(self.hi1[rows], self.hi2[cols], slack)
         hit = np.minimum(d_lo.min(axis=(1, 2)), d_hi.min(axis=(1, 2))) <= self.margin
-        low = np.minimum((d_lo - slack).min(axis=(1, 2)), (d_hi - slack).min(axis=(1, 2)))
-        return np.where(hit, HIT, np.where(low > self.margin, CLEAR, NEAR)).astype(np.int8)
+        clear = collision.bound_clears(d_lo, d_hi, self.move1[rows], self.move2[cols], self.margin)
+        return np.where(hit, HIT, np.where(clear, CLEAR, NEAR)).astype(np.int8)
 
     def _screen(self, rows: np.ndarray, cols: np.ndarray, tiles: bool = True) -> None:
         """Screen the unknown given entries (``tiles``: every unknown entry of their tiles)."""
@@ -165,9 +165,9 @@ class StepCheck:
         spans1 = np.stack([self.lo1[rows], self.hi1[rows]], 1)
         spans2 = np.stack([self.lo2[cols], self.hi2[cols]], 1)
         if self.swapped:  # the routine takes robot 1's samples first; its halving is symmetric
-            hit = motion.simultaneous_collide_many(self.q2, spans2, self.q1, spans1, self.margin)
+            hit = collision.motion_collides(self.q2, spans2, self.q1, spans1, self.margin)
         else:
-            hit = motion.simultaneous_collide_many(self.q1, spans1, self.q2, spans2, self.margin)
+            hit = collision.motion_collides(self.q1, spans1, self.q2, spans2, self.margin)
         self.state[rows, cols] = np.where(hit, COLLIDES, CLEAR)
 
     def table(self) -> np.ndarray:

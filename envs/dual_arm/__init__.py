@@ -3,6 +3,10 @@
 ``motiongym/DualArmCell-v0`` (Gymnasium, :class:`~.env.DualArmCellEnv`) and
 :func:`parallel_env` (PettingZoo ``ParallelEnv`` over the same world, agents
 ``robot_1`` and ``robot_2``). Nothing heavy is imported here.
+
+The IDs leave ``pairs`` at its default ("colliding") rather than naming it, so
+that ``gym.make(ID, task=...)``, its deprecated name, still works for one
+release (a keyword and its deprecated name together are refused).
 """
 
 from __future__ import annotations
@@ -14,13 +18,13 @@ REGISTRATIONS: tuple[dict, ...] = (
         "id": "motiongym/DualArmCell-v0",
         "entry_point": "motiongym.envs.dual_arm.env:DualArmCellEnv",
         "max_episode_steps": 1000,
-        "kwargs": {"control": "both", "task": "colliding"},
+        "kwargs": {"control": "both"},
     },
     {
         "id": "motiongym/DualArmCell-v1",
         "entry_point": "motiongym.envs.dual_arm.env:DualArmCellEnv",
         "max_episode_steps": 1000,
-        "kwargs": {"control": "both", "task": "colliding", "collision_check": "swept"},
+        "kwargs": {"control": "both", "collision_check": "swept"},
     },
 )
 

@@ -1,4 +1,9 @@
-"""PettingZoo ``ParallelEnv`` over the dual-arm cell: each robot times its own arm."""
+"""PettingZoo ``ParallelEnv`` over the dual-arm cell: each robot times its own arm.
+
+The same world and task as the Gymnasium environment (:class:`.world.DualArmWorld`,
+:class:`.task.DualArmTask`), through one :class:`~.env.DualArmCellEnv` with
+``control="both"``: the step, reward, ``info`` and checks are that environment's.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +15,9 @@ from pettingzoo import ParallelEnv
 
 from motiongym.envs.actions import checked_box_action
 from motiongym.envs.core import ArgumentError, check_int
-from motiongym.envs.dual_arm.env import OPTIONS, DualArmCellEnv
+from motiongym.envs.dual_arm.env import DualArmCellEnv
+from motiongym.envs.dual_arm.task import DualArmTask
+from motiongym.envs.dual_arm.world import DualArmWorld
 
 AGENTS = ("robot_1", "robot_2")
 
@@ -26,9 +33,11 @@ class DualArmParallelEnv(ParallelEnv):
     ``TimeLimit`` wrapper in PettingZoo; an integer in [1, 10**6]). Each
     agent's action is checked as the Gymnasium environment checks its own
     (shape (1,), finite, clipped to [0, 1]); an action for a name that is not
-    an agent is an error naming it. Reset options other than ``task`` are
-    ignored (PettingZoo's API test passes arbitrary ones). Other keywords go to the Gymnasium
-    environment (``task``, ``safety_margin``, reward weights, ``render_mode``).
+    an agent is an error naming it. Reset options other than the task's
+    (``pairs``, and ``task``, its deprecated name) are ignored (PettingZoo's API
+    test passes arbitrary ones). Other keywords go to the Gymnasium environment
+    (``pairs``, ``safety_margin``, reward weights, ``collision_check``,
+    ``render_mode``, ``render_size``).
     """
 
     metadata = {
@@ -47,6 +56,18 @@ class DualArmParallelEnv(ParallelEnv):
         self.render_mode = self._env.render_mode
         self._steps = 0
         self._action_space = spaces.Box(0.0, 1.0, (1,), np.float32)
+        task = self._env.task
+        self._options = set(task.options) | set(task.deprecated_options)
+
+    @property
+    def world(self) -> DualArmWorld:
+        """The world both agents move (the Gymnasium environment's)."""
+        return self._env.world
+
+    @property
+    def task(self) -> DualArmTask:
+        """The task that scores and observes it (the Gymnasium environment's)."""
+        return self._env.task
 
     def observation_space(self, agent: str) -> spaces.Space:
         return self._env.observation_space
@@ -58,7 +79,7 @@ class DualArmParallelEnv(ParallelEnv):
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict]]:
         # PettingZoo's API test resets with arbitrary options: pass on only ours.
-        ours = {k: v for k, v in (options or {}).items() if k in OPTIONS}
+        ours = {k: v for k, v in (options or {}).items() if k in self._options}
         obs, info = self._env.reset(seed=seed, options=ours)
         self.agents = list(AGENTS)
         self._steps = 0
@@ -103,4 +124,4 @@ class DualArmParallelEnv(ParallelEnv):
         return self._env.observation_space
 
     def state(self) -> np.ndarray:
-        return self._env.world.observation()
+        return self.task.observe(self.world)

@@ -29,7 +29,7 @@ of both arms' samples and the collision tests run in few NumPy operations
 drawing robot 1 until accepted, then robot 2 (:func:`_sample_arms`), so a
 seed's tasks do not depend on how the geometry is computed.
 
-With ``in_motion=True`` (``DualArmCell-v1``, whose check covers the motion
+With ``check="swept"`` (``DualArmCell-v1``, whose check covers the motion
 between samples) a ``"colliding"`` pair must also run one after the other
 collision free *in motion* (:func:`sequential_clear_in_motion`, the
 certified bound of :mod:`.motion`): at the samples alone 5 of 300 sampled
@@ -40,18 +40,31 @@ makes unsolvable by any start delay.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
+from gymnasium import spaces
 
+from motiongym.envs.checks import Deprecated, check_choice
+from motiongym.envs.core import Outcome, zero_terms
 from motiongym.envs.dual_arm import capsule_paths, model, motion
+from motiongym.envs.dual_arm.collision import CHECKS, SWEPT
+from motiongym.envs.layout import ObservationLayout
+
+if TYPE_CHECKING:
+    from motiongym.envs.dual_arm.params import DualArmParams
+    from motiongym.envs.dual_arm.world import DualArmWorld
 
 DT = 0.02  # s, controller sample time (paper)
 N_VIAS = 4
 V_MAX = np.array([2.0, 2.0, 2.0, 4.0, 4.0, 4.0])  # rad/s, our nominal joint speed limits
 PEAK = 15.0 / 8.0  # peak of ds/dtau for the quintic law
 MIN_TOOL_Z = 0.05  # m, the gripper tip stays above the floor
-TASK_MODES = ("colliding", "any", "paper")
+PAIRS = ("colliding", "any", "paper")  # the values of the pairs keyword
+TASK_MODES = PAIRS  # its former name
 
 # Joint boxes (rad) per via, in the arm's own base frame: start, pick, place, retreat.
 VIA_BOXES = np.array(
@@ -251,11 +264,16 @@ def sample_pair(
     mode: str = "colliding",
     margin: float = 0.0,
     max_tries: int = 1000,
-    in_motion: bool = False,
+    check: str = "samples",
 ) -> tuple[Trajectory, Trajectory]:
-    """A pair of tasks (robot 1, robot 2) drawn from ``rng``; see the module doc."""
-    if mode not in TASK_MODES:
-        raise ValueError(f"unknown task mode {mode!r}; choose one of {', '.join(TASK_MODES)}")
+    """A pair of tasks (robot 1, robot 2) drawn from ``rng``; see the module doc.
+
+    ``mode`` is one of :data:`PAIRS`; ``check`` the environment's collision check
+    (:data:`.collision.CHECKS`): on ``"swept"`` a "colliding" pair also runs one after
+    the other without contact in motion."""
+    if mode not in PAIRS:
+        raise ValueError(f"unknown pairs mode {mode!r}; choose one of {', '.join(PAIRS)}")
+    in_motion = check_choice("check", check, CHECKS) == SWEPT
     if mode == "paper":
         return paper_case()
     for _ in range(max_tries):
@@ -271,7 +289,7 @@ def sample_pair(
             return t1, t2
     raise RuntimeError(
         f"no pair that collides started together and clears by {margin} m one after the "
-        f"other in {max_tries} tries; lower safety_margin or use task='any'"
+        f"other in {max_tries} tries; lower safety_margin or use pairs='any'"
     )
 
 
@@ -310,3 +328,141 @@ def speeds_ok(traj: Trajectory) -> bool:
     q = traj.at_time(t)
     v = np.abs(np.diff(q, axis=0)) / np.diff(t)[:, None]
     return bool(np.all(v <= V_MAX * (1 + 1e-6)))
+
+
+# ---------------------------------------------------------------- the episode's task
+
+_TASK = N_VIAS * 6 + N_VIAS - 1  # one arm's compact task: vias, then segment durations
+LAYOUT = ObservationLayout(
+    [
+        ("q1", 6, "rad", "robot 1 joint angles q1..q6 (robot 1 joints)"),
+        ("q2", 6, "rad", "robot 2 joint angles q1..q6 (robot 2 joints)"),
+        ("progress", 2, "-", "progress p_r / N_r of robot 1, robot 2"),
+        ("elapsed", 1, "s", "elapsed time (steps x 0.02 s)"),
+        (
+            "distances",
+            (5, 5),
+            "m",
+            "d_ij (paper eq. 1), robot-1 body i, robot-2 body j, row major",
+        ),
+        ("task1", _TASK, "rad, s", "robot 1 via configurations (4 x 6), segment durations (3)"),
+        ("task2", _TASK, "rad, s", "robot 2 via configurations (4 x 6), segment durations (3)"),
+    ]
+)
+_Q = slice(LAYOUT["q1"].start, LAYOUT["q2"].stop)
+_P1, _P2 = LAYOUT["progress"].start, LAYOUT["progress"].start + 1
+_ELAPSED = LAYOUT["elapsed"].start
+_D = LAYOUT["distances"]
+_TASKS = slice(LAYOUT["task1"].start, LAYOUT["task2"].stop)
+
+
+def observation_bounds() -> tuple[np.ndarray, np.ndarray]:
+    """``(low, high)`` of the observation (:data:`LAYOUT`)."""
+    lim = model.JOINT_LIMITS
+    task_low = np.concatenate([np.tile(lim[:, 0], N_VIAS), np.zeros(N_VIAS - 1)])
+    task_high = np.concatenate([np.tile(lim[:, 1], N_VIAS), np.full(N_VIAS - 1, 60.0)])
+    return LAYOUT.bounds(
+        {
+            "q1": (lim[:, 0], lim[:, 1]),
+            "q2": (lim[:, 0], lim[:, 1]),
+            "progress": (0.0, 1.0),
+            "elapsed": (0.0, 1.0e4),
+            "distances": (-1.0, 5.0),  # m, by the cell's size
+            "task1": (task_low, task_high),
+            "task2": (task_low, task_high),
+        }
+    )
+
+
+def tasks_from_observation(obs: np.ndarray) -> tuple[Trajectory, Trajectory]:
+    """Rebuild both arms' trajectories from an observation (what planners do)."""
+    obs = np.asarray(obs, dtype=float)
+    out = []
+    for r, key in enumerate(("task1", "task2")):
+        flat = obs[LAYOUT[key]]
+        out.append(Trajectory.from_compact(flat[: N_VIAS * 6], flat[N_VIAS * 6 :], r))
+    return out[0], out[1]
+
+
+def _pairs_option_from_task(value: Any, current: Any) -> str:
+    """The ``pairs`` option from its deprecated name ``task`` (a bad value named as given)."""
+    return check_choice("options['task']", value, PAIRS)
+
+
+class StepEvents(NamedTuple):
+    """What one step of the world did (:meth:`.world.DualArmWorld.advance`)."""
+
+    collided: bool  # the step collides on the world's check (:mod:`.collision`)
+    progress_before: float  # p_1 / N_1 + p_2 / N_2 before the step
+    robot_2_wait: float  # s robot 2 spent not advancing in the step (0 once it is done)
+
+
+class DualArmTask:
+    """Sample a task pair, score the step, observe (the environment's docstring).
+
+    Reward terms (weights from :class:`.params.DualArmParams`): ``time``,
+    ``collision``, ``clearance`` (costs) and ``advance`` (paid). Reset option:
+    ``pairs`` (:data:`PAIRS`; ``task`` its deprecated name).
+    """
+
+    reward_terms: tuple[str, ...] = ("time", "collision", "clearance", "advance")
+    layout = LAYOUT
+
+    def __init__(self, params: DualArmParams) -> None:
+        self.params = params
+        self.weights = params.weights
+        lo, hi = observation_bounds()
+        self.observation_space: spaces.Space = spaces.Box(lo, hi, dtype=np.float32)
+        self.options: Mapping[str, Callable[[str, Any], Any]] = {
+            "pairs": partial(check_choice, choices=PAIRS)
+        }
+        self.deprecated_options = {"task": Deprecated("pairs", _pairs_option_from_task)}
+        self._wait2 = 0.0
+        self._template = np.empty(LAYOUT.size, dtype=np.float32)
+
+    def sample(self, rng: np.random.Generator, options: Mapping[str, Any]) -> tuple:
+        p = self.params
+        mode = options.get("pairs", p.pairs)
+        return sample_pair(rng, mode, p.safety_margin, check=p.collision_check)
+
+    def begin(self, world: DualArmWorld) -> Outcome:
+        self._wait2 = 0.0
+        assert world.tasks is not None  # the world was reset
+        traj1, traj2 = world.tasks
+        self._template = np.empty(LAYOUT.size, dtype=np.float32)  # the tasks part is fixed
+        self._template[_TASKS] = np.concatenate([traj1.compact(), traj2.compact()])
+        return self._outcome(world, False, zero_terms(self.reward_terms))
+
+    def evaluate(self, world: DualArmWorld, events: StepEvents) -> Outcome:
+        self._wait2 += events.robot_2_wait
+        w, d, collided = self.weights, world.distance, events.collided
+        terms = {
+            "time": -w["time"] * DT,
+            "collision": -w["collision"] if collided else 0.0,
+            "clearance": -w["clearance"] * max(0.0, 1.0 - d / self.params.clearance_distance),
+            "advance": w["advance"] * (world.p1 / world.n1 + world.p2 / world.n2
+                                       - events.progress_before),
+        }  # fmt: skip
+        return self._outcome(world, collided, terms)
+
+    def _outcome(self, world: DualArmWorld, collided: bool, terms: dict[str, float]) -> Outcome:
+        done = world.p1 >= world.n1 and world.p2 >= world.n2
+        measures = {
+            "collision": collided,
+            "distance": world.distance,
+            "makespan": world.steps * DT,
+            "progress_1": world.p1,
+            "progress_2": world.p2,
+            "robot_2_wait": self._wait2,
+        }
+        return Outcome(terms, not collided and done, 1.0 if collided else 0.0, measures,
+                       collided or done)  # fmt: skip
+
+    def observe(self, world: DualArmWorld) -> np.ndarray:
+        obs = self._template.copy()
+        obs[_Q] = world.qpos
+        obs[_P1] = world.p1 / world.n1
+        obs[_P2] = world.p2 / world.n2
+        obs[_ELAPSED] = world.steps * DT
+        obs[_D] = world.distances.ravel()
+        return obs

@@ -124,9 +124,11 @@ def test_arms_that_collide_at_rest_are_reported_not_delayed(where):
     env = gym.make(V1, control="robot_2")
     policy = make_policy(V1, "boundary-following", env.observation_space, env.action_space, KW)
     env.reset(seed=0)
-    env.unwrapped.world.load(t1, t2)
+    base = env.unwrapped
+    base.world.reset((t1, t2), base.np_random)  # this pair in place of the sampled one
+    base.task.begin(base.world)
     policy.reset()
-    policy.predict(env.unwrapped.world.observation())
+    policy.predict(base.task.observe(base.world))
     diagnostics = policy.diagnostics()
     assert diagnostics["fallback"] and diagnostics["reason"] == plan.reason
 

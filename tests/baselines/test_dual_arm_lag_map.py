@@ -10,8 +10,7 @@ from dual_arm_runs import run_policy, run_pure_delay
 
 from motiongym.baselines import make_policy
 from motiongym.baselines.dual_arm.lag_map import LagMap
-from motiongym.envs.dual_arm.task import DT
-from motiongym.envs.dual_arm.world import OBS, tasks_from_observation
+from motiongym.envs.dual_arm.task import DT, LAYOUT, tasks_from_observation
 
 V0, V1 = "motiongym/DualArmCell-v0", "motiongym/DualArmCell-v1"
 
@@ -25,9 +24,7 @@ def test_first_clear_go_is_the_environments_minimum_delay(env_id):
     params = env.unwrapped.params
     for seed in (100000, 100001, 100002):
         obs, _ = env.reset(seed=seed)
-        lag_map = LagMap(
-            *tasks_from_observation(obs), params.safety_margin, params.collision_check == "swept"
-        )
+        lag_map = LagMap(*tasks_from_observation(obs), params.safety_margin, params.collision_check)
         first = next(x for x in range(lag_map.n1 + 1) if lag_map.clear_now(x, 0.0))
         assert first > 0  # "colliding" pairs: starting together collides
         assert run_pure_delay(env, seed, first), (env_id, seed, first)
@@ -40,7 +37,7 @@ def test_window_rows_are_the_further_waits():
     row's last entry is its first colliding step over the horizon."""
     env = gym.make(V1)
     obs, _ = env.reset(seed=100003)
-    lag_map = LagMap(*tasks_from_observation(obs), 0.0, True)
+    lag_map = LagMap(*tasks_from_observation(obs), 0.0, "swept")
     lags = [0, 5, 12]
     later = lag_map.window(12, 0.0, [0], 1, 300)
     earlier = lag_map.window(0, 0.0, lags, 1, 312)
@@ -68,7 +65,7 @@ def test_replanning_teacher_acts_as_the_planned_delay_on_v1(seed):
     while not done:
         a, _ = plain.predict(obs, episode_start=start)
         b, _ = replan.predict(obs, episode_start=start)
-        if obs[OBS["progress"]][1] < 1.0:
+        if obs[LAYOUT["progress"]][1] < 1.0:
             assert np.array_equal(a, b)
         obs, _, terminated, truncated, info = env.step(a)
         start, done = np.array([False]), terminated or truncated
@@ -97,12 +94,12 @@ def test_robot_1_waiting_is_read_off_the_swapped_table(env_id):
     the usual table's (each trajectory on its own robot's base)."""
     env = gym.make(env_id)
     params = env.unwrapped.params
-    swept = params.collision_check == "swept"
+    check = params.collision_check
     for seed in (100000, 100001, 100002):
         obs, _ = env.reset(seed=seed)
         traj1, traj2 = tasks_from_observation(obs)
-        usual = LagMap(traj1, traj2, params.safety_margin, swept)
-        swapped = LagMap(traj2, traj1, params.safety_margin, swept)
+        usual = LagMap(traj1, traj2, params.safety_margin, check)
+        swapped = LagMap(traj2, traj1, params.safety_margin, check)
         assert (swapped.lead, swapped.wait) == (1, 0)
         n1, n2 = usual.n1, usual.n2
         moving = usual.table[:n1, 1 : n2 + 1]  # robot 1 on move s1, robot 2 on move k
@@ -119,7 +116,7 @@ def test_free_lags_are_the_rows_that_stay_clear():
     states part-way (scene 100004, v1)."""
     env = gym.make(V1)
     obs, _ = env.reset(seed=100004)
-    lag_map = LagMap(*tasks_from_observation(obs), 0.0, True)
+    lag_map = LagMap(*tasks_from_observation(obs), 0.0, "swept")
     for x, p2 in ((0, 0.0), (30, 12.0), (50, 7.5)):
         free = lag_map.free_lags(x, p2)
         horizon = 2 * (lag_map.n1 - x) + lag_map.n2 + 2

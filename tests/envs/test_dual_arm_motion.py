@@ -79,7 +79,7 @@ def test_the_swept_check_clears_what_stays_apart():
 def test_the_swept_map_delay_never_collides_in_the_v1_environment(seed):
     rng = np.random.default_rng(seed)
     t1, t2 = task.sample_pair(rng, "colliding", 0.0)
-    delay = boundary_following(CollisionMap.from_tasks(t1, t2, 100, 0.0, swept=True)).delay
+    delay = boundary_following(CollisionMap.from_tasks(t1, t2, 100, 0.0, check="swept")).delay
     assert delay is not None
     env = gym.make("motiongym/DualArmCell-v1").unwrapped
     env.reset(seed=0)

@@ -34,7 +34,15 @@ WEIRD = st.one_of(
     st.lists(st.floats(allow_nan=True), max_size=3),
     st.complex_numbers(max_magnitude=1e3),
 )
-PARALLEL_KEYWORDS = ["max_steps", "task", "safety_margin", "clearance_distance", "time", "control"]
+PARALLEL_KEYWORDS = [
+    "max_steps",
+    "pairs",
+    "task",
+    "safety_margin",
+    "clearance_distance",
+    "time",
+    "control",
+]
 
 
 @given(name=st.sampled_from(PARALLEL_KEYWORDS), value=WEIRD, seed=st.integers(0, 2**31))

@@ -60,7 +60,7 @@ PLAUSIBLE = st.one_of(
 
 # Every world's reset options (and one no world has); values: odd scalars, or vectors and
 # point lists of plausible lengths with odd entries (positions, joint angles, obstacles).
-OPTION_KEYS = ["task", "start", "heading", "fruit", "obstacles", "q", "q0", "target"]
+OPTION_KEYS = ["pairs", "task", "start", "heading", "fruit", "obstacles", "q", "q0", "target"]
 ODD = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([0.0, 0.3, -2.0]))
 VECTORS = st.one_of(
     st.lists(ODD, min_size=1, max_size=8),
