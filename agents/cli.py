@@ -14,8 +14,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from motiongym.agents.environments import (
     LONG_EPISODE,
     check_env_id,
@@ -31,6 +29,7 @@ from motiongym.envs.core import ArgumentError
 
 DEFAULT_EPISODES = 10
 MAX_SEED = 2**32 - 1  # NumPy, Gymnasium and torch all take seeds in [0, 2**32)
+MAX_ENV_KWARG_BYTES = 64 * 1024  # one --env-kwargs value
 
 
 class _Parser(argparse.ArgumentParser):
@@ -103,17 +102,19 @@ def _check_writable_above(text: str, path: Path) -> None:
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
-    """``["dof=5", "map_name=maze"]`` -> ``{"dof": 5, "map_name": "maze"}`` (values as YAML)."""
+    """``["dof=5", "map_name=maze"]`` -> ``{"dof": 5, "map_name": "maze"}`` (values as YAML,
+    read by :func:`motiongym.agents.limits.load_yaml`: no aliases, at most
+    :data:`MAX_ENV_KWARG_BYTES` each); a key given twice is refused."""
+    from motiongym.agents.limits import load_yaml
+
     kwargs = {}
     for pair in pairs:
         key, sep, value = pair.partition("=")
         if not sep or not key:
-            raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair!r}")
-        try:
-            kwargs[key] = yaml.safe_load(value)
-        except yaml.YAMLError as error:
-            problem = getattr(error, "problem", None) or type(error).__name__
-            raise UsageError(f"--env-kwargs {pair!r}: the value is not YAML ({problem})") from None
+            raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair[:100]!r}")
+        if key in kwargs:
+            raise UsageError(f"--env-kwargs gives {key!r} twice; give each key once")
+        kwargs[key] = load_yaml(value, f"--env-kwargs {key[:100]}", MAX_ENV_KWARG_BYTES)
     return kwargs
 
 

@@ -42,6 +42,7 @@ from stable_baselines3.common.save_util import data_to_json
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
 from motiongym.agents.errors import UsageError
+from motiongym.agents.limits import check_zip, load_json, load_npz
 
 NORMALIZATION_FILE = "vecnormalize.npz"
 PICKLED_NORMALIZATION = "vecnormalize.pkl"
@@ -58,6 +59,9 @@ RUNTIME_ENTRIES: dict[str, Any] = {  # rollout state, irrelevant to acting: star
     "action_noise": None,
 }
 MAX_MEMBER_BYTES = 1 << 30  # no archive member unpacks past 1 GiB
+MAX_ARCHIVE_BYTES = 1 << 30  # nor all of them together
+MAX_DATA_BYTES = 16 << 20  # the data JSON (a few kB to a few MB in SB3's own files)
+MAX_NORMALIZATION_BYTES = 64 << 20  # a normalisation file's arrays, all together
 # Entries SB3 writes that a model gets only when set up (with its environment): with
 # the attributes of a model made without setting up, every entry a data JSON may hold.
 SETUP_ENTRIES = {
@@ -91,10 +95,13 @@ def read_archive_data(path: Path) -> dict[str, Any]:
                 raise UsageError(f"{path}: unexpected archive member(s) {unknown}; refused")
             if "data" not in names:
                 raise UsageError(f"{path} is not a Stable-Baselines3 model file (no data entry)")
-            large = [i.filename for i in archive.infolist() if i.file_size > MAX_MEMBER_BYTES]
-            if large:
-                raise UsageError(f"{path}: member(s) {large} unpack past {MAX_MEMBER_BYTES} bytes")
-            data = json.loads(archive.read("data"))
+            check_zip(path, archive, MAX_MEMBER_BYTES, MAX_ARCHIVE_BYTES)
+            if archive.getinfo("data").file_size > MAX_DATA_BYTES:
+                raise UsageError(
+                    f"{path}: its data entry declares {archive.getinfo('data').file_size} "
+                    f"bytes; at most {MAX_DATA_BYTES} allowed"
+                )
+            data = load_json(archive.read("data"), f"{path} (data)", MAX_DATA_BYTES)
     except UsageError:
         raise
     except Exception as error:  # noqa: BLE001 - any failure to read a file from anyone
@@ -303,11 +310,7 @@ def save_normalization(normalization: VecNormalize, path: Path) -> Path:
 
 def load_normalization(path: Path, venv: VecEnv) -> VecNormalize:
     """VecNormalize over ``venv`` (evaluation mode) from a ``.npz`` written above."""
-    try:
-        with np.load(path, allow_pickle=False) as file:
-            arrays = {name: file[name] for name in file.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
-        raise UsageError(f"{path}: not a normalisation file ({error})") from error
+    arrays = load_npz(path, MAX_NORMALIZATION_BYTES, MAX_NORMALIZATION_BYTES)
     for name, value in arrays.items():
         if value.dtype.kind not in "fb" or not np.isfinite(value.astype(float)).all():
             raise UsageError(f"{path}: {name} is not finite numbers; refused")

@@ -46,7 +46,6 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import torch
-import yaml
 from gymnasium import spaces
 from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
@@ -56,6 +55,7 @@ from motiongym.agents.environments import resolved_env_kwargs
 from motiongym.agents.errors import UsageError
 from motiongym.agents.learners import memories
 from motiongym.agents.learners.memory import MapMemoryPredictor
+from motiongym.agents.limits import read_yaml_file
 from motiongym.agents.models.files import (
     NORMALIZATION_FILE,
     PICKLED_NORMALIZATION,
@@ -200,11 +200,7 @@ def run_config(file: Path) -> dict[str, Any]:
     config_file = file.parent / CONFIG_FILE
     if not config_file.is_file():
         return {}
-    try:
-        config = yaml.safe_load(config_file.read_text())
-    except (yaml.YAMLError, UnicodeDecodeError) as error:
-        problem = " ".join(str(error).split())
-        raise UsageError(f"{config_file}: not valid YAML ({problem})") from None
+    config = read_yaml_file(config_file)
     if not isinstance(config, dict):
         raise UsageError(f"{config_file} must be a mapping of the run's settings")
     return validated_run_config(config, config_file)

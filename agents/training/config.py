@@ -89,12 +89,11 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import yaml
-
 from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.learners import features_extractors, memories
 from motiongym.agents.learners.memory import check_memory_kwargs
+from motiongym.agents.limits import read_yaml_file
 from motiongym.agents.models.files import algorithm_classes
 from motiongym.envs.core import ArgumentError, check_bool, check_choice, check_float, check_int
 
@@ -156,11 +155,7 @@ def _document(path: Path) -> dict[str, Any]:
     """The YAML file at ``path`` as ``{algorithm: block}``, or a named error."""
     if not path.is_file():
         raise UsageError(f"no configuration file at {path}")
-    try:
-        document = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as error:
-        problem = " ".join(str(error).split())
-        raise UsageError(f"malformed YAML in {path}: {problem}") from error
+    document = read_yaml_file(path)
     if not isinstance(document, dict) or not document:
         raise UsageError(f"{path} must map algorithm names to blocks of settings")
     return document
