@@ -75,9 +75,9 @@ def _folder(text: str) -> Path:
     """An output folder: it may not exist yet, but may not be a file, and what of it
     exists must be a writable folder (checked before any work, not after it)."""
     path = Path(text)
+    _check_writable_above(text, path)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
-    _check_writable_above(text, path)
     return path
 
 
@@ -85,20 +85,42 @@ def _file(text: str) -> Path:
     """An output file: it may not exist yet, but may not be a folder; its folder must
     be (or be makeable in) a writable folder."""
     path = Path(text)
+    _check_writable_above(text, path.parent)
     if path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
-    _check_writable_above(text, path.parent)
     return path
 
 
+PSEUDO_FILESYSTEMS = ("/proc", "/sys", "/dev")  # kernel interfaces, never output folders
+
+
 def _check_writable_above(text: str, path: Path) -> None:
-    existing = path
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
+    """Refuse, before any work, an output path that could not be written: a name longer
+    than the file system allows, a place under a file, a kernel interface
+    (:data:`PSEUDO_FILESYSTEMS`) or a folder the user cannot write in."""
+    shown = text if len(text) <= 80 else f"{text[:80]}... ({len(text)} characters)"
+    try:
+        existing = path.absolute()
+        while not existing.exists() and existing != existing.parent:
+            existing = existing.parent
+        limit = os.pathconf(existing, "PC_NAME_MAX") if existing.is_dir() else 255
+        long = [part for part in Path(text).parts if len(os.fsencode(part)) > limit]
+        if long:
+            raise argparse.ArgumentTypeError(
+                f"{shown!r}: a name of {len(os.fsencode(long[0]))} bytes; at most {limit} allowed"
+            )
+        resolved = existing.resolve()
+    except OSError as error:
+        raise argparse.ArgumentTypeError(f"{shown!r}: {error.strerror or error}") from None
     if not existing.is_dir():
-        raise argparse.ArgumentTypeError(f"{text!r} lies under {str(existing)!r}, a file")
+        raise argparse.ArgumentTypeError(f"{shown!r} lies under {str(existing)!r}, a file")
+    if any(resolved == Path(p) or Path(p) in resolved.parents for p in PSEUDO_FILESYSTEMS):
+        raise argparse.ArgumentTypeError(
+            f"{shown!r} lies under {str(resolved)!r}, a kernel interface; choose a folder "
+            "outside " + ", ".join(PSEUDO_FILESYSTEMS)
+        )
     if not os.access(existing, os.W_OK):
-        raise argparse.ArgumentTypeError(f"{text!r}: cannot write in {str(existing)!r}")
+        raise argparse.ArgumentTypeError(f"{shown!r}: cannot write in {str(existing)!r}")
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
