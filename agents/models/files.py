@@ -62,6 +62,9 @@ MAX_MEMBER_BYTES = 1 << 30  # no archive member unpacks past 1 GiB
 MAX_ARCHIVE_BYTES = 1 << 30  # nor all of them together
 MAX_DATA_BYTES = 16 << 20  # the data JSON (a few kB to a few MB in SB3's own files)
 MAX_NORMALIZATION_BYTES = 64 << 20  # a normalisation file's arrays, all together
+# (low, high]: VecNormalize clips to [-clip_obs, clip_obs], divides by sqrt(var + epsilon)
+# and weighs its statistics by count (the steps seen, at least SB3's initial 1e-4).
+NORMALIZATION_RANGES = {"clip_obs": (0.0, 1e6), "epsilon": (0.0, 1.0), "count": (0.0, 1e15)}
 # Entries SB3 writes that a model gets only when set up (with its environment): with
 # the attributes of a model made without setting up, every entry a data JSON may hold.
 SETUP_ENTRIES = {
@@ -224,6 +227,31 @@ def _plain_rate(entry: Any) -> float:
     return float(value) if isinstance(value, (int, float)) else 0.0
 
 
+def _check_net_arch(path: Path, data: dict[str, Any], run: dict[str, Any]) -> None:
+    """Refuse a run config whose ``net_arch`` is not the one the archive was saved with."""
+    import ast
+
+    stored = data.get("policy_kwargs")
+    if "net_arch" not in run or not isinstance(stored, dict) or "net_arch" not in stored:
+        return
+    saved = stored["net_arch"]
+    if isinstance(saved, str):
+        try:
+            saved = ast.literal_eval(saved)
+        except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
+            return  # not a literal: SB3's loading compares the weights' shapes
+    if saved != run["net_arch"]:
+        raise UsageError(
+            f"{path}: the run's config.yml gives net_arch {_short(run['net_arch'])}, the model "
+            f"was saved with {_short(saved)}; refused"
+        )
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else f"{text[:80]}..."
+
+
 def load_archive(
     path: Path,
     observation_space: spaces.Space,
@@ -245,6 +273,7 @@ def load_archive(
         raise UsageError(f"{path}: unknown data entr{'y' if len(extra) == 1 else 'ies'} {extra}")
     check_space(path, data, "observation_space", observation_space, what)
     check_space(path, data, "action_space", action_space, what)
+    _check_net_arch(path, data, policy_kwargs or {})
     rate = data.get("learning_rate", 0.0)
     steps = data.get("train_freq", {}) if isinstance(data.get("train_freq"), dict) else {}
     supply: dict[str, Any] = {
@@ -316,6 +345,14 @@ def load_normalization(path: Path, venv: VecEnv) -> VecNormalize:
             raise UsageError(f"{path}: {name} is not finite numbers; refused")
         if name.startswith("var") and (value < 0).any():
             raise UsageError(f"{path}: {name} has a negative variance; refused")
+    for name, value in arrays.items():
+        if name in ("clip_obs", "epsilon") or name.startswith("count"):
+            low, high = NORMALIZATION_RANGES[name.split(".")[0]]
+            if value.shape != () or not low < float(value) <= high:
+                raise UsageError(
+                    f"{path}: {name} must be one number in ({low:g}, {high:g}], got "
+                    f"{np.array2string(value, threshold=4)}; refused"
+                )
     try:
         normalization = VecNormalize(
             venv,
