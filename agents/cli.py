@@ -75,9 +75,10 @@ def _folder(text: str) -> Path:
     """An output folder: it may not exist yet, but may not be a file, and what of it
     exists must be a writable folder (checked before any work, not after it)."""
     path = Path(text)
-    _check_writable_above(text, path)
+    _check_names(text)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    _check_writable_above(text, path)
     return path
 
 
@@ -85,30 +86,43 @@ def _file(text: str) -> Path:
     """An output file: it may not exist yet, but may not be a folder; its folder must
     be (or be makeable in) a writable folder."""
     path = Path(text)
-    _check_writable_above(text, path.parent)
+    _check_names(text)
     if path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+    _check_writable_above(text, path.parent)
     return path
 
 
 PSEUDO_FILESYSTEMS = ("/proc", "/sys", "/dev")  # kernel interfaces, never output folders
 
 
+def _shown(text: str) -> str:
+    return text if len(text) <= 80 else f"{text[:80]}... ({len(text)} characters)"
+
+
+def _check_names(text: str) -> None:
+    """Refuse an output path with a name (a part between slashes) or a whole longer than
+    Linux allows (255 and 4095 bytes), before anything looks it up."""
+    long = [part for part in Path(text).parts if len(os.fsencode(part)) > 255]
+    if long:
+        raise argparse.ArgumentTypeError(
+            f"{_shown(text)!r}: a name of {len(os.fsencode(long[0]))} bytes; at most 255 allowed"
+        )
+    if len(os.fsencode(text)) > 4095:
+        raise argparse.ArgumentTypeError(
+            f"{_shown(text)!r}: a path of {len(os.fsencode(text))} bytes; at most 4095 allowed"
+        )
+
+
 def _check_writable_above(text: str, path: Path) -> None:
-    """Refuse, before any work, an output path that could not be written: a name longer
-    than the file system allows, a place under a file, a kernel interface
-    (:data:`PSEUDO_FILESYSTEMS`) or a folder the user cannot write in."""
-    shown = text if len(text) <= 80 else f"{text[:80]}... ({len(text)} characters)"
+    """Refuse, before any work, an output path that could not be written: a place
+    under a file, a kernel interface (:data:`PSEUDO_FILESYSTEMS`) or a folder the
+    user cannot write in."""
+    shown = _shown(text)
     try:
         existing = path.absolute()
         while not existing.exists() and existing != existing.parent:
             existing = existing.parent
-        limit = os.pathconf(existing, "PC_NAME_MAX") if existing.is_dir() else 255
-        long = [part for part in Path(text).parts if len(os.fsencode(part)) > limit]
-        if long:
-            raise argparse.ArgumentTypeError(
-                f"{shown!r}: a name of {len(os.fsencode(long[0]))} bytes; at most {limit} allowed"
-            )
         resolved = existing.resolve()
     except OSError as error:
         raise argparse.ArgumentTypeError(f"{shown!r}: {error.strerror or error}") from None
@@ -136,7 +150,12 @@ def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
             raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair[:100]!r}")
         if key in kwargs:
             raise UsageError(f"--env-kwargs gives {key!r} twice; give each key once")
-        kwargs[key] = load_yaml(value, f"--env-kwargs {key[:100]}", MAX_ENV_KWARG_BYTES)
+        kwargs[key] = load_yaml(
+            value,
+            f"--env-kwargs {key[:100]}",
+            MAX_ENV_KWARG_BYTES,
+            malformed=f"--env-kwargs {pair[:100]!r}: the value is not YAML",
+        )
     return kwargs
 
 

@@ -74,8 +74,11 @@ class _GuardedLoader(yaml.SafeLoader):
             self.depth -= 1
 
 
-def load_yaml(text: str | bytes, where: str, max_bytes: int = MAX_YAML_BYTES) -> Any:
-    """The YAML document ``text`` (from ``where``, named in errors), checked as above."""
+def load_yaml(
+    text: str | bytes, where: str, max_bytes: int = MAX_YAML_BYTES, malformed: str = ""
+) -> Any:
+    """The YAML document ``text`` (from ``where``, named in errors), checked as above;
+    ``malformed``: the message of a syntax error, if not ``malformed YAML in <where>``."""
     size = len(text.encode() if isinstance(text, str) else text)
     if size > max_bytes:
         raise UsageError(f"{where} is {size} bytes of YAML; at most {max_bytes} allowed")
@@ -89,6 +92,9 @@ def load_yaml(text: str | bytes, where: str, max_bytes: int = MAX_YAML_BYTES) ->
         return loader.get_single_data()
     except yaml.YAMLError as error:
         problem = " ".join(str(error).split())[:300]
+        if malformed:
+            problem = getattr(error, "problem", None) or type(error).__name__
+            raise UsageError(f"{malformed} ({problem})") from None
         raise UsageError(f"malformed YAML in {where}: {problem}") from None
     except RecursionError:
         raise UsageError(f"{where}: YAML nested too deeply; refused") from None
