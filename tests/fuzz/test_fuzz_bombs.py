@@ -20,7 +20,6 @@ import sys
 import time
 import zipfile
 import zlib
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -42,7 +41,7 @@ from motiongym.envs.sweeper.maps import MAX_SIDE, MapError, load_map_file
 ENV_ID = "motiongym/HarvestArm-v0"  # a shipped PPO model with normalisation statistics
 BILLION_LAUGHS = "\n".join(
     ["a: &a [x, x, x, x, x, x, x, x, x]"]
-    + [f"{c}: &{c} [{', '.join([f'*{p}'] * 9)}]" for p, c in zip("abcdefg", "bcdefgh")]
+    + [f"{c}: &{c} [{', '.join([f'*{p}'] * 9)}]" for p, c in zip("abcdefg", "bcdefgh", strict=True)]
 )
 
 
