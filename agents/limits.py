@@ -38,7 +38,7 @@ MAX_YAML_NODES = 20_000  # values in one YAML document
 MAX_DEPTH = 64  # nesting of lists and mappings in YAML and JSON
 MAX_HASHED_BYTES = 1 << 30  # a file of a model folder, hashed against its manifest
 RATIO_FLOOR = 1 << 20  # members at most this large may compress any amount
-MAX_RATIO = 50.0  # declared / compressed size of a larger member
+MAX_RATIO = 10.0  # declared / compressed size of a larger member (SB3 stores: 1.0)
 
 
 def _shown(value: Any, limit: int = 80) -> str:
