@@ -20,6 +20,7 @@ import sys
 import time
 import zipfile
 import zlib
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -326,3 +327,13 @@ def test_ruinous_network_and_rollout_sizes_are_refused(tmp_path, setting, messag
 def test_json_limits_hold_for_plain_documents():
     assert limits.load_json(json.dumps({"a": [1, 2]}), "x", 100) == {"a": [1, 2]}
     assert limits.load_yaml("a: [1, 2]\nb: {c: 3}\n", "x") == {"a": [1, 2], "b": {"c": 3}}
+
+
+def test_bench_with_an_unknown_id_writes_nothing(tmp_path, capsys):
+    import tempfile
+
+    before = set(Path(tempfile.gettempdir()).glob("SB3-*"))
+    assert main(["bench", "motiongym/Nope-v0", "--out", str(tmp_path / "bench")]) == 2
+    assert "unknown environment ID 'motiongym/Nope-v0'" in capsys.readouterr().err
+    assert set(Path(tempfile.gettempdir()).glob("SB3-*")) == before
+    assert not (tmp_path / "bench").exists()
