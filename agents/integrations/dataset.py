@@ -34,9 +34,11 @@ import numpy as np
 from motiongym.agents.environments import check_env_id, made_kwargs, make_env, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluation.episodes import Step, run_episode
+from motiongym.agents.limits import read_json_file
 from motiongym.baselines import make_policy, scripted_policies
 
 DATASET_SEED = 500_000  # first episode's seed; evaluations start at 100_000 and count up
+MAX_METADATA_BYTES = 1 << 20  # a dataset's metadata.json (a few kB)
 METADATA_KEYS = ("env_id", "policy_name", "policy_class", "policy_version", "first_seed")
 
 
@@ -182,6 +184,10 @@ def load_demonstrations(path: Path | str, env: gym.Env) -> Any:
         raise ValueError(
             f"path must be a Minari dataset folder (with data/metadata.json), got {path}"
         )
+    try:  # the metadata checked (size, nesting) before Minari parses them
+        read_json_file(folder / "data" / "metadata.json", MAX_METADATA_BYTES)
+    except UsageError as error:
+        raise ValueError(str(error)) from None
     dataset = minari.MinariDataset(folder / "data")
     meta = dataset.storage.metadata
     env_id = env.spec.id if env.spec else None
