@@ -8,7 +8,7 @@ holds and what is allowed:
 * YAML (:func:`load_yaml`): at most :data:`MAX_YAML_BYTES`; aliases
   (``*name``, and with them merge keys) are refused, so an alias bomb
   ("billion laughs") cannot expand; nesting at most :data:`MAX_DEPTH` and at
-  most :data:`MAX_YAML_NODES` values.
+  most :data:`MAX_YAML_NODES` values; a mapping key given twice is refused.
 * JSON (:func:`load_json`): at most the caller's byte cap; nesting at most
   :data:`MAX_DEPTH`.
 * Zip archives (:func:`check_zip`): every member's declared size, their
@@ -72,6 +72,24 @@ class _GuardedLoader(yaml.SafeLoader):
             return super().compose_node(parent, index)
         finally:
             self.depth -= 1
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+        """PyYAML's mapping, but a key given twice is refused (PyYAML keeps the last)."""
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    duplicate = key in seen
+                    seen.add(key)
+                except TypeError:  # unhashable: PyYAML's own error follows
+                    continue
+                if duplicate:
+                    raise UsageError(
+                        f"{self.where}: key {_shown(key)} given twice (line "
+                        f"{key_node.start_mark.line + 1}); give each key once"
+                    )
+        return super().construct_mapping(node, deep)
 
 
 def load_yaml(

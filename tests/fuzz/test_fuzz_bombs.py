@@ -337,3 +337,10 @@ def test_bench_with_an_unknown_id_writes_nothing(tmp_path, capsys):
     assert "unknown environment ID 'motiongym/Nope-v0'" in capsys.readouterr().err
     assert set(Path(tempfile.gettempdir()).glob("SB3-*")) == before
     assert not (tmp_path / "bench").exists()
+
+
+def test_a_key_given_twice_in_a_config_is_refused(tmp_path):
+    config = tmp_path / "twice.yml"
+    config.write_text("ppo:\n  n_timesteps: 1\n  policy: MlpPolicy\n  n_timesteps: 2\n")
+    with pytest.raises(UsageError, match=r"key 'n_timesteps' given twice \(line 4\)"):
+        load_config(config, "ppo")
