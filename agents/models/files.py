@@ -20,6 +20,11 @@ so nothing in it is unpickled, ever:
   ``allow_pickle=False``; every statistic must be finite and every variance
   non-negative. SB3's ``vecnormalize.pkl`` is a pickle and is never read: a
   folder that has only that file is refused with the way out.
+* **Sizes** are checked before anything is read (:mod:`motiongym.agents.limits`):
+  archive members' declared sizes (each and together at most 1 GiB, the
+  ``data`` JSON at most 16 MiB, a member past 1 MiB at most 10 times its
+  stored size), ``.npy`` headers against their members, nesting of JSON;
+  a run's ``config.yml`` whose ``net_arch`` is not the archive's is refused.
 * **Manifests** (:mod:`motiongym.agents.models.pretrained`): ``motiongym train`` and
   ``ship`` write ``manifest.json`` (the SHA-256 of every file); a folder with
   one is verified before use, a folder without one loads only when the user

@@ -55,8 +55,9 @@ from motiongym.agents.environments import resolved_env_kwargs
 from motiongym.agents.errors import UsageError
 from motiongym.agents.learners import memories
 from motiongym.agents.learners.memory import MapMemoryPredictor
-from motiongym.agents.limits import read_yaml_file
+from motiongym.agents.limits import load_npz, read_yaml_file
 from motiongym.agents.models.files import (
+    MAX_NORMALIZATION_BYTES,
     NORMALIZATION_FILE,
     PICKLED_NORMALIZATION,
     load_archive,
@@ -263,6 +264,8 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
     zoo_normalization(file, env_id)
     check_provenance(file, trust)
     config = run_config(file)
+    if (file.parent / NORMALIZATION_FILE).is_file():  # its sizes checked before the model loads
+        load_npz(file.parent / NORMALIZATION_FILE, MAX_NORMALIZATION_BYTES, MAX_NORMALIZATION_BYTES)
     kwargs = _run_policy_kwargs(config)
     predictor: Any  # the model behind each layer its run asks for
     if config.get("vec_env") == "pettingzoo":  # one policy shared among the agents
