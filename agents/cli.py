@@ -14,8 +14,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from motiongym.agents.environments import (
     LONG_EPISODE,
     check_env_id,
@@ -31,6 +29,7 @@ from motiongym.envs.core import ArgumentError
 
 DEFAULT_EPISODES = 10
 MAX_SEED = 2**32 - 1  # NumPy, Gymnasium and torch all take seeds in [0, 2**32)
+MAX_ENV_KWARG_BYTES = 64 * 1024  # one --env-kwargs value
 
 
 class _Parser(argparse.ArgumentParser):
@@ -76,6 +75,7 @@ def _folder(text: str) -> Path:
     """An output folder: it may not exist yet, but may not be a file, and what of it
     exists must be a writable folder (checked before any work, not after it)."""
     path = Path(text)
+    _check_names(text)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
     _check_writable_above(text, path)
@@ -86,34 +86,76 @@ def _file(text: str) -> Path:
     """An output file: it may not exist yet, but may not be a folder; its folder must
     be (or be makeable in) a writable folder."""
     path = Path(text)
+    _check_names(text)
     if path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
     _check_writable_above(text, path.parent)
     return path
 
 
+PSEUDO_FILESYSTEMS = ("/proc", "/sys", "/dev")  # kernel interfaces, never output folders
+
+
+def _shown(text: str) -> str:
+    return text if len(text) <= 80 else f"{text[:80]}... ({len(text)} characters)"
+
+
+def _check_names(text: str) -> None:
+    """Refuse an output path with a name (a part between slashes) or a whole longer than
+    Linux allows (255 and 4095 bytes), before anything looks it up."""
+    long = [part for part in Path(text).parts if len(os.fsencode(part)) > 255]
+    if long:
+        raise argparse.ArgumentTypeError(
+            f"{_shown(text)!r}: a name of {len(os.fsencode(long[0]))} bytes; at most 255 allowed"
+        )
+    if len(os.fsencode(text)) > 4095:
+        raise argparse.ArgumentTypeError(
+            f"{_shown(text)!r}: a path of {len(os.fsencode(text))} bytes; at most 4095 allowed"
+        )
+
+
 def _check_writable_above(text: str, path: Path) -> None:
-    existing = path
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
+    """Refuse, before any work, an output path that could not be written: a place
+    under a file, a kernel interface (:data:`PSEUDO_FILESYSTEMS`) or a folder the
+    user cannot write in."""
+    shown = _shown(text)
+    try:
+        existing = path.absolute()
+        while not existing.exists() and existing != existing.parent:
+            existing = existing.parent
+        resolved = existing.resolve()
+    except OSError as error:
+        raise argparse.ArgumentTypeError(f"{shown!r}: {error.strerror or error}") from None
     if not existing.is_dir():
-        raise argparse.ArgumentTypeError(f"{text!r} lies under {str(existing)!r}, a file")
+        raise argparse.ArgumentTypeError(f"{shown!r} lies under {str(existing)!r}, a file")
+    if any(resolved == Path(p) or Path(p) in resolved.parents for p in PSEUDO_FILESYSTEMS):
+        raise argparse.ArgumentTypeError(
+            f"{shown!r} lies under {str(resolved)!r}, a kernel interface; choose a folder "
+            "outside " + ", ".join(PSEUDO_FILESYSTEMS)
+        )
     if not os.access(existing, os.W_OK):
-        raise argparse.ArgumentTypeError(f"{text!r}: cannot write in {str(existing)!r}")
+        raise argparse.ArgumentTypeError(f"{shown!r}: cannot write in {str(existing)!r}")
 
 
 def _env_kwargs(pairs: list[str]) -> dict[str, Any]:
-    """``["dof=5", "map_name=maze"]`` -> ``{"dof": 5, "map_name": "maze"}`` (values as YAML)."""
+    """``["dof=5", "map_name=maze"]`` -> ``{"dof": 5, "map_name": "maze"}`` (values as YAML,
+    read by :func:`motiongym.agents.limits.load_yaml`: no aliases, at most
+    :data:`MAX_ENV_KWARG_BYTES` each); a key given twice is refused."""
+    from motiongym.agents.limits import load_yaml
+
     kwargs = {}
     for pair in pairs:
         key, sep, value = pair.partition("=")
         if not sep or not key:
-            raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair!r}")
-        try:
-            kwargs[key] = yaml.safe_load(value)
-        except yaml.YAMLError as error:
-            problem = getattr(error, "problem", None) or type(error).__name__
-            raise UsageError(f"--env-kwargs {pair!r}: the value is not YAML ({problem})") from None
+            raise UsageError(f"--env-kwargs takes KEY=VALUE pairs, got {pair[:100]!r}")
+        if key in kwargs:
+            raise UsageError(f"--env-kwargs gives {key!r} twice; give each key once")
+        kwargs[key] = load_yaml(
+            value,
+            f"--env-kwargs {key[:100]}",
+            MAX_ENV_KWARG_BYTES,
+            malformed=f"--env-kwargs {pair[:100]!r}: the value is not YAML",
+        )
     return kwargs
 
 

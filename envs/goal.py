@@ -124,15 +124,29 @@ class GoalFields:
         return flat
 
 
+# The goal fields functions the systems registered (:func:`goal_registration`):
+# ``{name: "module:function"}``. The keyword ``fields`` names one of these; no
+# other string is imported.
+GOAL_FIELDS: dict[str, str] = {}
+
+
 def load(name: str, reference: Any) -> Any:
-    """The object named ``"module:attribute"`` (the argument ``name``), else ArgumentError."""
-    if isinstance(reference, str) and reference.count(":") == 1:
-        module, attribute = reference.split(":")
-        try:
-            return getattr(importlib.import_module(module), attribute)
-        except (ImportError, AttributeError, ValueError, TypeError):
-            pass
-    raise ArgumentError(f"{name} must name an object as 'module:attribute', got {reference!r}")
+    """The goal fields function ``reference``: a name in :data:`GOAL_FIELDS` (registered
+    by :func:`goal_registration`) or a callable passed from Python, else ArgumentError.
+
+    A string is looked up, never imported as given: only the registered
+    ``"module:function"`` targets are imported.
+    """
+    if callable(reference):
+        return reference
+    if isinstance(reference, str) and reference in GOAL_FIELDS:
+        module, attribute = GOAL_FIELDS[reference].split(":")
+        return getattr(importlib.import_module(module), attribute)
+    shown = reference[:200] if isinstance(reference, str) else reference
+    raise ArgumentError(
+        f"{name} must be one of the registered goal fields {sorted(GOAL_FIELDS)} "
+        f"(or a callable, from Python), got {shown!r}"
+    )
 
 
 def _check_base(base: Any) -> str:
@@ -152,7 +166,7 @@ def resolve(env_kwargs: Mapping[str, Any]) -> tuple[str, dict[str, Any], GoalFie
     if "base" not in env_kwargs or "fields" not in env_kwargs:
         raise ArgumentError(
             f"a goal env needs the keyword arguments 'base' (an ID) and 'fields' "
-            f"('module:function'), got {sorted(env_kwargs)}"
+            f"(one of {sorted(GOAL_FIELDS)}), got {sorted(env_kwargs)}"
         )
     base = _check_base(env_kwargs["base"])
     kwargs = {**gym.spec(base).kwargs}
@@ -165,7 +179,12 @@ def resolve(env_kwargs: Mapping[str, Any]) -> tuple[str, dict[str, Any], GoalFie
 
 
 def goal_registration(base: Mapping[str, Any], goal_id: str, fields: str) -> dict[str, Any]:
-    """The registration of ``goal_id``: the goal variant of the registration ``base``."""
+    """The registration of ``goal_id``: the goal variant of the registration ``base``.
+
+    ``fields`` (``"module:function"``) is added to :data:`GOAL_FIELDS`, the
+    names the keyword ``fields`` accepts.
+    """
+    GOAL_FIELDS[fields] = fields
     return {
         "id": goal_id,
         "entry_point": ENTRY_POINT,
@@ -177,12 +196,12 @@ def goal_registration(base: Mapping[str, Any], goal_id: str, fields: str) -> dic
 class GoalConditionedEnv(gym.Env):
     """A reaching task as a ``GoalEnv`` (module docstring): the base ID's env, goal split out.
 
-    Keyword arguments: ``base`` (the base ID), ``fields`` (``"module:function"``
-    returning its :class:`GoalFields`), ``collision`` (>= 0, default 50, the
-    penalty of a collision step), ``cost`` (>= 0, default 0, per unit of
-    ``info["cost"]``); every other keyword goes to the base env (its reward
-    weights change nothing here: the reward is this one; the harvest arm's
-    own ``collision`` weight is shadowed by the penalty of the same name).
+    Keyword arguments: ``base`` (the base ID), ``fields`` (a name in
+    :data:`GOAL_FIELDS`, or from Python a callable, returning its :class:`GoalFields`),
+    ``collision`` (>= 0, default 50, the penalty of a collision step), ``cost``
+    (>= 0, default 0, per unit of ``info["cost"]``); every other keyword goes to
+    the base env (its reward weights change nothing here: the reward is this
+    one; the harvest arm's own ``collision`` weight is shadowed by the penalty of the same name).
 
     Observation: ``Dict(observation, achieved_goal, desired_goal)``, float32,
     bounds the base observation's. ``info``: the base env's, its
@@ -192,7 +211,7 @@ class GoalConditionedEnv(gym.Env):
 
     metadata = {"render_modes": ["rgb_array", "human"]}  # every base's; an instance has its base's
 
-    def __init__(self, base: str, fields: str, collision: float = 50.0, cost: float = 0.0, **kw):
+    def __init__(self, base: str, fields: Any, collision: float = 50.0, cost: float = 0.0, **kw):
         self.collision = check_float("collision", collision, 0.0, 1e6)
         self.cost = check_float("cost", cost, 0.0, 1e6)
         self.base_id, base_kwargs, self.fields = resolve({"base": base, "fields": fields, **kw})

@@ -32,7 +32,7 @@ import minigrid  # noqa: F401  (registers the MiniGrid reference)
 import numpy as np
 from rich.markdown import Markdown
 
-from motiongym.agents.environments import make_env, resolved_env_kwargs
+from motiongym.agents.environments import check_env_id, make_env, resolved_env_kwargs
 from motiongym.agents.evaluation.report import console
 from motiongym.baselines import make_policy, scripted_policies
 from motiongym.envs import ENV_IDS
@@ -135,7 +135,10 @@ def ppo_steps_per_second(env_id: str, timesteps: int) -> float:
     policy = (
         "MultiInputPolicy" if isinstance(env.observation_space, gym.spaces.Dict) else "MlpPolicy"
     )
+    from stable_baselines3.common.logger import Logger
+
     model = PPO(policy, env, n_steps=512, batch_size=64, n_epochs=4, device="cpu", seed=0)
+    model.set_logger(Logger(folder=None, output_formats=[]))  # SB3's default makes a temp folder
     start = time.perf_counter()
     model.learn(total_timesteps=timesteps)
     return timesteps / (time.perf_counter() - start)
@@ -185,6 +188,8 @@ def bench(out_dir: Path, quick: bool = False, env_ids: list[str] | None = None) 
     """Measure everything; print the tables; write ``bench.json`` and ``bench.md``."""
     seconds = 0.5 if quick else 3.0
     env_ids = list(env_ids or ENV_IDS)
+    for env_id in env_ids:  # every ID checked before any work
+        check_env_id(env_id)
     results: dict[str, Any] = {"machine": machine(), "quick": quick, "references": {}}
     references = {reference: gym.make(reference) for reference in REFERENCES}
     results["references"].update(interleaved_steps_per_second(references, seconds))

@@ -21,11 +21,13 @@ import numpy as np
 from PIL import Image
 
 from motiongym.agents.environments import make_env, short_name
+from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluation.episodes import Step, run_episode
 from motiongym.agents.models.predictors import load_predictor, policy_label
 
 GIF_WIDTH = 320  # pixels; the README's GIFs stay well under 2 MB
 VIDEO_EXTRA = 'pip install "motiongym[video]"'
+MAX_FRAME_SECONDS = 60  # the longest a recorded frame may show
 
 
 def mp4_available() -> bool:
@@ -84,11 +86,21 @@ def record(
     ``<ID>_<policy>_seed<S>.gif`` (and ``.mp4``) into ``out_dir``.
 
     ``every``: keep one frame in ``every`` steps (the videos play at the
-    environment's ``render_fps / every``, so in real time).
+    environment's ``render_fps / every``, so in real time); at most
+    ``MAX_FRAME_SECONDS * render_fps``, so that a frame lasts at most
+    :data:`MAX_FRAME_SECONDS` (GIF stores a frame's time in 16 bits).
     """
-    if every < 1:
+    if isinstance(every, bool) or not isinstance(every, int) or every < 1:
         raise ValueError(f"every must be an integer >= 1, got {every!r}")
     env = make_env(env_id, env_kwargs, render_mode="rgb_array")
+    render_fps = float(env.metadata.get("render_fps", 30))
+    most = max(1, int(MAX_FRAME_SECONDS * render_fps))
+    if every > most:
+        env.close()
+        raise UsageError(
+            f"--every must be in [1, {most}] for {env_id} (it renders {render_fps:g} frames "
+            f"per second; a frame lasts at most {MAX_FRAME_SECONDS} s), got {every}"
+        )
     predictor = load_predictor(policy, env_id, env, env_kwargs, trust=trust)
     frames: list[np.ndarray] = []
 
@@ -97,7 +109,7 @@ def record(
             frames.append(np.asarray(env.render()))
 
     episode = run_episode(env, predictor, seed, hook=keep)
-    fps = float(env.metadata.get("render_fps", 30)) / every
+    fps = render_fps / every
     env.close()
     out_dir.mkdir(parents=True, exist_ok=True)
     stem = out_dir / f"{short_name(env_id)}_{policy_label(policy)}_seed{seed}"

@@ -6,7 +6,9 @@ scripted policy ``NAME`` declared for ``ID`` on ``N`` seeded episodes (episode
 the evaluation seeds, so demonstrations never show a held-out scene) and
 writes them with Minari's ``DataCollector`` (Farama's offline-RL format,
 observations, actions, rewards, terminations, truncations and every ``info``
-key) under ``DIR/<dataset id>``. The metadata name the teacher:
+key) under ``DIR/<dataset id>``, with the observation and action spaces of
+the environment made (with ``env_kwargs``, its spec too), so that the
+metadata describe the data. The metadata name the teacher:
 ``algorithm_name`` is ``"<policy> (motiongym <version>)"`` and the keys
 :data:`METADATA_KEYS` hold the ID, the policy's name, class and version (the
 package's: a scripted policy changes only with a release) and the first seed.
@@ -29,12 +31,14 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from motiongym.agents.environments import check_env_id, made_kwargs, short_name
+from motiongym.agents.environments import check_env_id, made_kwargs, make_env, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluation.episodes import Step, run_episode
+from motiongym.agents.limits import read_json_file
 from motiongym.baselines import make_policy, scripted_policies
 
 DATASET_SEED = 500_000  # first episode's seed; evaluations start at 100_000 and count up
+MAX_METADATA_BYTES = 1 << 20  # a dataset's metadata.json (a few kB)
 METADATA_KEYS = ("env_id", "policy_name", "policy_class", "policy_version", "first_seed")
 
 
@@ -93,7 +97,7 @@ def record_dataset(
     path = Path(out) / name
     if path.exists():
         raise UsageError(f"{path} exists already; remove it or choose another --out")
-    env = gym.make(env_id, **(env_kwargs or {}))
+    env = make_env(env_id, env_kwargs)  # the keywords checked as for every command
     teacher = make_policy(env_id, policy, env.observation_space, env.action_space, made_kwargs(env))
     buffers = [_episode(minari, env, teacher, seed + i, i) for i in range(episodes)]
     successes = sum(bool(b.infos["is_success"][-1]) for b in buffers)
@@ -102,8 +106,11 @@ def record_dataset(
         dataset = minari.create_dataset_from_buffers(
             dataset_id=name,
             buffer=buffers,
-            env=env_id,
-            eval_env=env_id,
+            # the spec made (its keywords) where they are not the registered ones
+            env=env.spec if env_kwargs and env.spec else env_id,
+            eval_env=env.spec if env_kwargs and env.spec else env_id,
+            observation_space=env.observation_space,  # the spaces of the data it holds
+            action_space=env.action_space,
             algorithm_name=f"{policy} (motiongym {__version__})",
             author="motiongym",
             description=f"scripted {policy!r} on {env_id}, seeds {seed}-{seed + episodes - 1}",
@@ -177,6 +184,10 @@ def load_demonstrations(path: Path | str, env: gym.Env) -> Any:
         raise ValueError(
             f"path must be a Minari dataset folder (with data/metadata.json), got {path}"
         )
+    try:  # the metadata checked (size, nesting) before Minari parses them
+        read_json_file(folder / "data" / "metadata.json", MAX_METADATA_BYTES)
+    except UsageError as error:
+        raise ValueError(str(error)) from None
     dataset = minari.MinariDataset(folder / "data")
     meta = dataset.storage.metadata
     env_id = env.spec.id if env.spec else None
@@ -188,10 +199,18 @@ def load_demonstrations(path: Path | str, env: gym.Env) -> Any:
     for kind in ("observation_space", "action_space"):
         if getattr(dataset, kind) != getattr(env, kind):
             raise ValueError(
-                f"dataset {path} has the {kind} {getattr(dataset, kind)}, the environment "
-                f"{getattr(env, kind)}"
+                f"dataset {path} has the {kind} {_space_text(getattr(dataset, kind))}, the "
+                f"environment {_space_text(getattr(env, kind))} (record it with the same "
+                "env_kwargs)"
             )
     return dataset
+
+
+def _space_text(space: Any) -> str:
+    """A one-line name of a space: its class and shape (or its keys)."""
+    if isinstance(space, gym.spaces.Dict):
+        return f"Dict({', '.join(f'{k}: {_space_text(v)}' for k, v in space.spaces.items())})"
+    return f"{type(space).__name__}{getattr(space, 'shape', '')}"
 
 
 def transitions(dataset: Any) -> tuple[Any, np.ndarray]:

@@ -29,6 +29,7 @@ import yaml
 from motiongym.agents.environments import check_env_id, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.integrations.sweep import import_ray, start_ray
+from motiongym.agents.limits import read_yaml_file
 from motiongym.envs import ENV_IDS
 from motiongym.systems import declared
 
@@ -79,7 +80,7 @@ def load_rllib_settings(env_id: str, path: Path | None = None) -> dict[str, dict
     path = path or default_rllib_config()
     if not path.is_file():
         raise UsageError(f"no RLlib configuration file at {path}")
-    document = yaml.safe_load(path.read_text()) or {}
+    document = read_yaml_file(path) or {}
     if not isinstance(document, dict):
         raise UsageError(f"{path}: expected a mapping of 'default' and IDs")
     for key, block in document.items():

@@ -25,10 +25,9 @@ import shlex
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from motiongym.agents.environments import check_env_id
 from motiongym.agents.errors import UsageError
+from motiongym.agents.limits import load_npz
 
 RAY_EXTRA = "pip install 'motiongym[ray]'"
 DEFAULT_CONFIG = "default"  # the group name of configs/<Name>-vN.yml
@@ -108,7 +107,7 @@ def final_evaluation(run_dir: Path) -> dict[str, float]:
     file = run_dir / "eval" / "evaluations.npz"
     if not file.is_file():
         return {"eval_return": float("nan"), "eval_success": float("nan")}
-    data = np.load(file)
+    data = load_npz(file, 64 << 20, 64 << 20)
     success = data["successes"][-1].mean() if "successes" in data else float("nan")
     return {"eval_return": float(data["results"][-1].mean()), "eval_success": float(success)}
 

@@ -33,6 +33,7 @@ from typing import Any
 
 import yaml
 
+from motiongym.agents.limits import read_yaml_file
 from motiongym.agents.training.config import ACTIVATIONS, default_config_path
 from motiongym.envs import ENV_IDS
 
@@ -96,7 +97,7 @@ def zoo_file(algo: str) -> str:
     blocks, commands, left_out = {}, [], []
     for env_id in ENV_IDS:
         path = default_config_path(env_id)
-        document = yaml.safe_load(path.read_text()) if path.is_file() else {}
+        document = read_yaml_file(path) if path.is_file() else {}
         if algo not in document:
             continue
         reason = refusal(document[algo])

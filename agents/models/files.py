@@ -20,6 +20,11 @@ so nothing in it is unpickled, ever:
   ``allow_pickle=False``; every statistic must be finite and every variance
   non-negative. SB3's ``vecnormalize.pkl`` is a pickle and is never read: a
   folder that has only that file is refused with the way out.
+* **Sizes** are checked before anything is read (:mod:`motiongym.agents.limits`):
+  archive members' declared sizes (each and together at most 1 GiB, the
+  ``data`` JSON at most 16 MiB, a member past 1 MiB at most 10 times its
+  stored size), ``.npy`` headers against their members, nesting of JSON;
+  a run's ``config.yml`` whose ``net_arch`` is not the archive's is refused.
 * **Manifests** (:mod:`motiongym.agents.models.pretrained`): ``motiongym train`` and
   ``ship`` write ``manifest.json`` (the SHA-256 of every file); a folder with
   one is verified before use, a folder without one loads only when the user
@@ -42,6 +47,7 @@ from stable_baselines3.common.save_util import data_to_json
 from stable_baselines3.common.vec_env import VecEnv, VecNormalize
 
 from motiongym.agents.errors import UsageError
+from motiongym.agents.limits import check_zip, load_json, load_npz
 
 NORMALIZATION_FILE = "vecnormalize.npz"
 PICKLED_NORMALIZATION = "vecnormalize.pkl"
@@ -58,6 +64,12 @@ RUNTIME_ENTRIES: dict[str, Any] = {  # rollout state, irrelevant to acting: star
     "action_noise": None,
 }
 MAX_MEMBER_BYTES = 1 << 30  # no archive member unpacks past 1 GiB
+MAX_ARCHIVE_BYTES = 1 << 30  # nor all of them together
+MAX_DATA_BYTES = 16 << 20  # the data JSON (a few kB to a few MB in SB3's own files)
+MAX_NORMALIZATION_BYTES = 64 << 20  # a normalisation file's arrays, all together
+# (low, high]: VecNormalize clips to [-clip_obs, clip_obs], divides by sqrt(var + epsilon)
+# and weighs its statistics by count (the steps seen, at least SB3's initial 1e-4).
+NORMALIZATION_RANGES = {"clip_obs": (0.0, 1e6), "epsilon": (0.0, 1.0), "count": (0.0, 1e15)}
 # Entries SB3 writes that a model gets only when set up (with its environment): with
 # the attributes of a model made without setting up, every entry a data JSON may hold.
 SETUP_ENTRIES = {
@@ -91,10 +103,13 @@ def read_archive_data(path: Path) -> dict[str, Any]:
                 raise UsageError(f"{path}: unexpected archive member(s) {unknown}; refused")
             if "data" not in names:
                 raise UsageError(f"{path} is not a Stable-Baselines3 model file (no data entry)")
-            large = [i.filename for i in archive.infolist() if i.file_size > MAX_MEMBER_BYTES]
-            if large:
-                raise UsageError(f"{path}: member(s) {large} unpack past {MAX_MEMBER_BYTES} bytes")
-            data = json.loads(archive.read("data"))
+            check_zip(path, archive, MAX_MEMBER_BYTES, MAX_ARCHIVE_BYTES)
+            if archive.getinfo("data").file_size > MAX_DATA_BYTES:
+                raise UsageError(
+                    f"{path}: its data entry declares {archive.getinfo('data').file_size} "
+                    f"bytes; at most {MAX_DATA_BYTES} allowed"
+                )
+            data = load_json(archive.read("data"), f"{path} (data)", MAX_DATA_BYTES)
     except UsageError:
         raise
     except Exception as error:  # noqa: BLE001 - any failure to read a file from anyone
@@ -217,6 +232,31 @@ def _plain_rate(entry: Any) -> float:
     return float(value) if isinstance(value, (int, float)) else 0.0
 
 
+def _check_net_arch(path: Path, data: dict[str, Any], run: dict[str, Any]) -> None:
+    """Refuse a run config whose ``net_arch`` is not the one the archive was saved with."""
+    import ast
+
+    stored = data.get("policy_kwargs")
+    if "net_arch" not in run or not isinstance(stored, dict) or "net_arch" not in stored:
+        return
+    saved = stored["net_arch"]
+    if isinstance(saved, str):
+        try:
+            saved = ast.literal_eval(saved)
+        except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
+            return  # not a literal: SB3's loading compares the weights' shapes
+    if saved != run["net_arch"]:
+        raise UsageError(
+            f"{path}: the run's config.yml gives net_arch {_short(run['net_arch'])}, the model "
+            f"was saved with {_short(saved)}; refused"
+        )
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else f"{text[:80]}..."
+
+
 def load_archive(
     path: Path,
     observation_space: spaces.Space,
@@ -238,6 +278,7 @@ def load_archive(
         raise UsageError(f"{path}: unknown data entr{'y' if len(extra) == 1 else 'ies'} {extra}")
     check_space(path, data, "observation_space", observation_space, what)
     check_space(path, data, "action_space", action_space, what)
+    _check_net_arch(path, data, policy_kwargs or {})
     rate = data.get("learning_rate", 0.0)
     steps = data.get("train_freq", {}) if isinstance(data.get("train_freq"), dict) else {}
     supply: dict[str, Any] = {
@@ -303,16 +344,20 @@ def save_normalization(normalization: VecNormalize, path: Path) -> Path:
 
 def load_normalization(path: Path, venv: VecEnv) -> VecNormalize:
     """VecNormalize over ``venv`` (evaluation mode) from a ``.npz`` written above."""
-    try:
-        with np.load(path, allow_pickle=False) as file:
-            arrays = {name: file[name] for name in file.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
-        raise UsageError(f"{path}: not a normalisation file ({error})") from error
+    arrays = load_npz(path, MAX_NORMALIZATION_BYTES, MAX_NORMALIZATION_BYTES)
     for name, value in arrays.items():
         if value.dtype.kind not in "fb" or not np.isfinite(value.astype(float)).all():
             raise UsageError(f"{path}: {name} is not finite numbers; refused")
         if name.startswith("var") and (value < 0).any():
             raise UsageError(f"{path}: {name} has a negative variance; refused")
+    for name, value in arrays.items():
+        if name in ("clip_obs", "epsilon") or name.startswith("count"):
+            low, high = NORMALIZATION_RANGES[name.split(".")[0]]
+            if value.shape != () or not low < float(value) <= high:
+                raise UsageError(
+                    f"{path}: {name} must be one number in ({low:g}, {high:g}], got "
+                    f"{np.array2string(value, threshold=4)}; refused"
+                )
     try:
         normalization = VecNormalize(
             venv,

@@ -46,7 +46,6 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import torch
-import yaml
 from gymnasium import spaces
 from sb3_contrib import MaskablePPO
 from stable_baselines3.common.base_class import BaseAlgorithm
@@ -56,7 +55,9 @@ from motiongym.agents.environments import resolved_env_kwargs
 from motiongym.agents.errors import UsageError
 from motiongym.agents.learners import memories
 from motiongym.agents.learners.memory import MapMemoryPredictor
+from motiongym.agents.limits import load_npz, read_yaml_file
 from motiongym.agents.models.files import (
+    MAX_NORMALIZATION_BYTES,
     NORMALIZATION_FILE,
     PICKLED_NORMALIZATION,
     load_archive,
@@ -200,11 +201,7 @@ def run_config(file: Path) -> dict[str, Any]:
     config_file = file.parent / CONFIG_FILE
     if not config_file.is_file():
         return {}
-    try:
-        config = yaml.safe_load(config_file.read_text())
-    except (yaml.YAMLError, UnicodeDecodeError) as error:
-        problem = " ".join(str(error).split())
-        raise UsageError(f"{config_file}: not valid YAML ({problem})") from None
+    config = read_yaml_file(config_file)
     if not isinstance(config, dict):
         raise UsageError(f"{config_file} must be a mapping of the run's settings")
     return validated_run_config(config, config_file)
@@ -267,6 +264,8 @@ def load_model(path: Path, env: gym.Env, env_id: str, trust: bool = False) -> An
     zoo_normalization(file, env_id)
     check_provenance(file, trust)
     config = run_config(file)
+    if (file.parent / NORMALIZATION_FILE).is_file():  # its sizes checked before the model loads
+        load_npz(file.parent / NORMALIZATION_FILE, MAX_NORMALIZATION_BYTES, MAX_NORMALIZATION_BYTES)
     kwargs = _run_policy_kwargs(config)
     predictor: Any  # the model behind each layer its run asks for
     if config.get("vec_env") == "pettingzoo":  # one policy shared among the agents

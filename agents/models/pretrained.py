@@ -12,11 +12,11 @@ puts a run's model here.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from importlib import resources
 from pathlib import Path
 
+from motiongym.agents import limits
 from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 
@@ -30,8 +30,12 @@ def pretrained_root() -> Path:
     return Path(str(resources.files("motiongym.agents.models") / "pretrained"))
 
 
+MAX_MANIFEST_BYTES = 1 << 20
+
+
 def sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    """The file's SHA-256, its size capped first (:func:`motiongym.agents.limits.sha256`)."""
+    return limits.sha256(path)
 
 
 def write_manifest(folder: Path) -> Path:
@@ -55,10 +59,7 @@ def verify_manifest(folder: Path, required: tuple[str, ...] = ()) -> None:
     manifest = folder / MANIFEST
     if not manifest.is_file():
         raise UsageError(f"{folder} has no {MANIFEST}")
-    try:
-        digests = json.loads(manifest.read_text())
-    except (UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise UsageError(f"{manifest} is not JSON ({error})") from None
+    digests = limits.read_json_file(manifest, MAX_MANIFEST_BYTES)
     if not isinstance(digests, dict) or not all(
         isinstance(n, str)
         and Path(n).name == n

@@ -13,11 +13,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from motiongym.agents.environments import check_env_id, long_episodes_note, make_env, short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.evaluation.episodes import EVALUATION_SEED, Evaluation, evaluate
+from motiongym.agents.limits import load_npz, read_json_file
 from motiongym.agents.models.predictors import CONFIG_FILE, MODEL_FILE, load_model, run_config
 from motiongym.agents.models.pretrained import (
     LEARNING_CURVES,
@@ -64,7 +63,7 @@ def _imitation_seconds(run_dir: Path) -> dict[str, float]:
     file = run_dir / "dagger.json"
     if not file.is_file():
         return {}
-    return {"dagger_seconds": float(json.loads(file.read_text())["seconds"])}
+    return {"dagger_seconds": float(read_json_file(file, 1 << 20)["seconds"])}
 
 
 def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:
@@ -72,7 +71,7 @@ def _learning_curve_rows(run_dir: Path, seed: int) -> list[str]:
     file = run_dir / "eval" / "evaluations.npz"
     if not file.is_file():
         return []
-    data = np.load(file)
+    data = load_npz(file, 64 << 20, 64 << 20)
     returns = data["results"].mean(axis=1)
     successes = (
         data["successes"].mean(axis=1) if "successes" in data else [float("nan")] * len(returns)

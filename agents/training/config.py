@@ -16,7 +16,8 @@ Run settings:
 ============== ===================================================== ==========
 key            meaning                                               default
 ============== ===================================================== ==========
-n_envs         parallel environments                                 1
+n_envs         parallel environments (1 to 1024; ``n_steps * n_envs`` 1
+               at most 10**7)
 n_timesteps    environment steps to train for                        required
 policy         SB3 policy name (``MlpPolicy``, ``MultiInputPolicy``) required
 policy_kwargs  network and activation (mapping)                      {}
@@ -80,6 +81,12 @@ deterministic  how the model acts in evaluations (the training        true
                mode loops where its samples do not; saved in the
                run's ``config.yml`` and so honoured for shipped models
 ============== ===================================================== ==========
+
+Bounds that keep a run's memory finite: ``policy_kwargs.net_arch`` at most
+16 hidden layers of at most 4096 units and 2**24 weights between one
+network's hidden layers (``[4096, 4096]``); ``n_steps * n_envs`` at most
+10**7. A configuration file is at most 256 kB of YAML, without aliases
+(:mod:`motiongym.agents.limits`).
 """
 
 from __future__ import annotations
@@ -89,12 +96,11 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import yaml
-
 from motiongym.agents.environments import short_name
 from motiongym.agents.errors import UsageError
 from motiongym.agents.learners import features_extractors, memories
 from motiongym.agents.learners.memory import check_memory_kwargs
+from motiongym.agents.limits import read_yaml_file
 from motiongym.agents.models.files import algorithm_classes
 from motiongym.envs.core import ArgumentError, check_bool, check_choice, check_float, check_int
 
@@ -156,11 +162,7 @@ def _document(path: Path) -> dict[str, Any]:
     """The YAML file at ``path`` as ``{algorithm: block}``, or a named error."""
     if not path.is_file():
         raise UsageError(f"no configuration file at {path}")
-    try:
-        document = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as error:
-        problem = " ".join(str(error).split())
-        raise UsageError(f"malformed YAML in {path}: {problem}") from error
+    document = read_yaml_file(path)
     if not isinstance(document, dict) or not document:
         raise UsageError(f"{path} must map algorithm names to blocks of settings")
     return document
@@ -253,6 +255,17 @@ _FLOAT_RANGES: dict[str, tuple[float, float, bool]] = {  # low, high, low open
 }
 
 
+MAX_LAYERS = 16  # hidden layers of one network
+MAX_LAYER_SIZE = 4096  # units of one hidden layer
+MAX_HIDDEN_WEIGHTS = 1 << 24  # weights between one network's hidden layers (64 MB float32)
+MAX_ROLLOUT = 10**7  # n_steps * n_envs: the transitions an on-policy rollout buffer holds
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else f"{text[:80]}... ({len(text)} characters)"
+
+
 def _check_values(config: dict[str, Any], algorithm: type[BaseAlgorithm]) -> None:
     """Types and ranges of the block's values, in the environments' message style."""
     for key, (low, high) in _INT_RANGES.items():
@@ -286,10 +299,23 @@ def _check_values(config: dict[str, Any], algorithm: type[BaseAlgorithm]) -> Non
         raise ArgumentError(f"net_arch keys must be among pi, vf, qf, got {sorted(arch)}")
     layers = arch.values() if isinstance(arch, dict) else [arch] if arch is not None else []
     for layer in layers:
-        if not isinstance(layer, list):
-            raise ArgumentError(f"net_arch must be a list of layer sizes, got {arch!r}")
+        if not isinstance(layer, list) or len(layer) > MAX_LAYERS:
+            raise ArgumentError(
+                f"net_arch must be a list of at most {MAX_LAYERS} layer sizes, got {_shown(arch)}"
+            )
         for size in layer:
-            check_int("net_arch layer size", size, 1, 65_536)
+            check_int("net_arch layer size", size, 1, MAX_LAYER_SIZE)
+        weights = sum(a * b for a, b in zip(layer, layer[1:], strict=False))
+        if weights > MAX_HIDDEN_WEIGHTS:
+            raise ArgumentError(
+                f"net_arch {layer} has {weights} weights between its hidden layers; at most "
+                f"{MAX_HIDDEN_WEIGHTS} allowed (e.g. [4096, 4096])"
+            )
+    if "n_steps" in config and config["n_steps"] * config["n_envs"] > MAX_ROLLOUT:
+        raise ArgumentError(
+            f"n_steps * n_envs must be at most {MAX_ROLLOUT} (the rollout buffer's "
+            f"transitions), got {config['n_steps']} * {config['n_envs']}"
+        )
     _check_replay_buffer(config)
     if config["residual"] is not None and not isinstance(config["residual"], str):
         raise ArgumentError(

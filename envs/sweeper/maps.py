@@ -29,6 +29,7 @@ from motiongym.envs.sweeper.occupancy import config_free, is_closed
 MAPS_DIR = pathlib.Path(__file__).with_name("map_files")
 SHIPPED_MAPS = ("room", "apartment", "maze")
 MAX_SIDE = 256  # largest map side (cells) the observation space allows
+MAX_MAP_BYTES = 1 << 20  # largest map file: a 256 x 256 text map is 66 kB
 
 
 class MapError(ValueError):
@@ -44,12 +45,22 @@ def parse_text_map(text: str, source: str = "<text>") -> np.ndarray:
 
     Every line must have the same length and hold only ``#`` and ``.``
     (blank lines after the map are ignored), so that line ``i`` is row ``i - 1``.
+    Lines end at ``\n`` (or ``\r\n``) only: any other character, a form feed
+    or a Unicode line separator included, is refused with its place. At most
+    :data:`MAX_SIDE` lines and columns, checked before the cells are read.
     """
-    lines = text.splitlines()
-    if not any(line.strip() for line in lines):
+    lines = [line.removesuffix("\r") for line in text.split("\n")]
+    while lines and not lines[-1].strip():
+        lines.pop()
+    if not lines:
         raise MapError(f"map {source} is empty")
-    first, last = 0, max(k for k, line in enumerate(lines) if line.strip())
+    first, last = 0, len(lines) - 1
     width = len(lines[first])
+    if len(lines) > MAX_SIDE or width > MAX_SIDE:
+        raise MapError(
+            f"map {source} has {len(lines)} lines of {width} cells; at most {MAX_SIDE} "
+            "of each are allowed"
+        )
     grid = np.ones((last - first + 1, width), dtype=bool)
     for i in range(first, last + 1):
         row = lines[i]
@@ -80,16 +91,44 @@ def load_map_file(path: str | os.PathLike, w: int = 1) -> np.ndarray:
     if not path.is_file():
         raise MapError(f"map_file must be an existing .txt or .png file, got {str(path)!r}")
     suffix = path.suffix.lower()
-    if suffix == ".png":
-        from PIL import Image
-
-        grey = np.asarray(Image.open(path).convert("L"))
-        grid, text = grey < 128, False
-    elif suffix in (".txt", ".map"):
-        grid, text = parse_text_map(path.read_text(), source=repr(str(path))), True
-    else:
+    if suffix not in (".png", ".txt", ".map"):
         raise MapError(f"map file {str(path)!r}: unknown format {suffix!r}; use .txt or .png")
+    size = path.stat().st_size
+    if size > MAX_MAP_BYTES:
+        raise MapError(f"map file {str(path)!r} is {size} bytes; at most {MAX_MAP_BYTES} allowed")
+    if suffix == ".png":
+        grid, text = _read_png(path), False
+    else:
+        try:
+            content = path.read_bytes().decode("utf-8")
+        except UnicodeDecodeError as error:
+            raise MapError(
+                f"map file {str(path)!r}: byte {error.start} is not UTF-8 text; "
+                "use '#' (obstacle) and '.' (free)"
+            ) from None
+        grid, text = parse_text_map(content, source=repr(str(path))), True
     return validate_map(grid, w, source=f"map {str(path)!r}", text=text)
+
+
+def _read_png(path: pathlib.Path) -> np.ndarray:
+    """The obstacle array of a PNG map (dark pixels), its size checked before decoding."""
+    from PIL import Image
+
+    try:
+        with Image.open(path, formats=["PNG"]) as image:
+            width, height = image.size
+            if max(width, height) > MAX_SIDE:
+                raise MapError(
+                    f"map file {str(path)!r} is {width} x {height} pixels; at most "
+                    f"{MAX_SIDE} on a side allowed"
+                )
+            grey = np.asarray(image.convert("L"))
+    except MapError:
+        raise
+    except Exception as error:  # noqa: BLE001 - any image from anyone: PIL's many errors
+        problem = " ".join(str(error).split())[:200]
+        raise MapError(f"map file {str(path)!r} is not a readable PNG ({problem})") from None
+    return grey < 128
 
 
 def _cell(r: int, c: int, text: bool) -> str:

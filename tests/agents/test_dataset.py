@@ -76,3 +76,21 @@ def test_cli_writes_a_dataset_and_refuses_to_overwrite(tmp_path, capsys):
     assert "exists already" in capsys.readouterr().err
     assert main([*args[:3], "nope", *args[4:]]) == 2
     assert "scripted policies: newton-raphson-reach" in capsys.readouterr().err
+
+
+def test_a_dataset_records_the_spaces_of_the_keywords_it_was_made_with(tmp_path, capsys):
+    """Recorded with ``dof=5`` on the 7-DOF ID: the metadata hold the 5-DOF spaces,
+    so loading it for the registered ID is refused; a bad keyword is refused first."""
+    env_id = "motiongym/HarvestArm-v0"
+    args = ["dataset", env_id, "--policy", "potential-field", "--episodes", "1"]
+    args += ["--out", str(tmp_path)]
+    assert main([*args, "--env-kwargs", "bogus=1"]) == 2
+    assert "unknown keyword argument(s) bogus" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+    path, _ = record_dataset(env_id, "potential-field", 1, tmp_path, env_kwargs={"dof": 5})
+    dataset = load_demonstrations(path, gym.make(env_id, dof=5))
+    assert dataset.action_space.shape == (5,)
+    with pytest.raises(
+        ValueError, match=r"observation_space Box\(166,\), the environment Box\(185,\)"
+    ):
+        load_demonstrations(path, gym.make(env_id))

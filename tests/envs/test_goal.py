@@ -131,7 +131,7 @@ def test_wrong_goal_shape_and_bad_arguments_are_clear_errors():
         env.compute_reward(np.zeros((4, 2)), np.zeros((3, 2)), {})
     with pytest.raises(ArgumentError, match="base must be a registered"):
         gym.make("motiongym/HarvestArmGoal-v1", base="motiongym/Nope-v0")
-    with pytest.raises(ArgumentError, match="fields must name"):
+    with pytest.raises(ArgumentError, match="fields must be one of the registered goal fields"):
         gym.make("motiongym/HarvestArmGoal-v1", fields="nowhere")
     with pytest.raises(ArgumentError, match="collision"):
         gym.make("motiongym/HarvestArmGoal-v1", collision=-1.0)
