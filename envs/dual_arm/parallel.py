@@ -33,7 +33,7 @@ class DualArmParallelEnv(ParallelEnv):
     ``TimeLimit`` wrapper in PettingZoo; an integer in [1, 10**6]). Each
     agent's action is checked as the Gymnasium environment checks its own
     (shape (1,), finite, clipped to [0, 1]); an action for a name that is not
-    an agent is an error naming it. Reset options other than the task's
+    an agent is an error naming it, as is a space asked for such a name. Reset options other than the task's
     (``pairs``, and ``task``, its deprecated name) are ignored (PettingZoo's API
     test passes arbitrary ones). Other keywords go to the Gymnasium environment
     (``pairs``, ``safety_margin``, reward weights, ``collision_check``,
@@ -69,15 +69,23 @@ class DualArmParallelEnv(ParallelEnv):
         """The task that scores and observes it (the Gymnasium environment's)."""
         return self._env.task
 
+    def _check_agent(self, agent: Any) -> None:
+        if agent not in AGENTS:
+            raise ArgumentError(f"agent must be one of {list(AGENTS)}, got {agent!r}")
+
     def observation_space(self, agent: str) -> spaces.Space:
+        self._check_agent(agent)
         return self._env.observation_space
 
     def action_space(self, agent: str) -> spaces.Box:
+        self._check_agent(agent)
         return self._action_space
 
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict]]:
+        if options is not None and not isinstance(options, dict):
+            raise ArgumentError(f"options must be a dict or None, got {options!r:.80}")
         # PettingZoo's API test resets with arbitrary options: pass on only ours.
         ours = {k: v for k, v in (options or {}).items() if k in self._options}
         obs, info = self._env.reset(seed=seed, options=ours)

@@ -248,3 +248,17 @@ def test_obs_is_the_deprecated_name_of_the_layout():
     with pytest.warns(MotiongymDeprecationWarning, match="'OBS' is deprecated.*LAYOUT"):
         assert world.OBS == LAYOUT.slices
     assert world.OBS["progress"] == slice(12, 14) and world.OBS_SIZE == LAYOUT.size == 94
+
+
+def test_parallel_env_refuses_bad_options_and_unknown_agents():
+    from motiongym.envs.dual_arm import parallel_env
+
+    env = parallel_env()
+    with pytest.raises(ValueError, match="options must be a dict or None, got 'x'"):
+        env.reset(options="x")
+    for ask in (env.observation_space, env.action_space):
+        with pytest.raises(
+            ValueError, match=r"agent must be one of \['robot_1', 'robot_2'\], got 'robot_3'"
+        ):
+            ask("robot_3")
+    env.close()
