@@ -44,7 +44,12 @@ def _flags():
                 yield name, action
 
 
-@pytest.mark.parametrize(("command", "action"), list(_flags()), ids=lambda x: str(x))
+# Ids name the flag, never the action's repr: that holds function addresses, which differ
+# between pytest-xdist workers, and the workers must collect the same tests.
+@pytest.mark.parametrize(
+    ("command", "action"),
+    [pytest.param(c, a, id=f"{c}{a.option_strings[-1]}") for c, a in _flags()],
+)
 def test_every_optional_flags_help_states_its_default(command, action):
     assert "default" in (action.help or ""), f"{command} {action.option_strings}"
 
