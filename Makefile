@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 EPISODES ?= 10
 
-.PHONY: install demo test test-slow lint models benchmarks fuzz docs test-ray test-zoo
+.PHONY: install demo test test-slow lint models benchmarks fuzz docs media test-ray test-zoo
 
 $(STAMP): pyproject.toml setup.py
 	python3 -m venv $(VENV)
@@ -45,6 +45,18 @@ docs: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[docs]"
 	MUJOCO_GL=egl $(BIN)/sphinx-build -W --keep-going -q -b html docs/site docs/site/_build/html
 	@echo "docs/site/_build/html/index.html"
+
+# The GIFs of the README and of the docs' environment pages (docs/media/<ID>_<policy>_seed1.gif,
+# 320 px wide): one episode (seed 1) of the paper's policy for each ID without one yet, a frame
+# every 4 steps (sweeper), 5 (dual-arm cell) or 2 (the others). About 15 s an ID; `make docs`
+# only copies them. Delete an ID's GIF to make it again.
+media: $(STAMP)
+	for id in $$(MUJOCO_GL=egl $(BIN)/python -c "import motiongym.envs as e; print(*e.ENV_IDS)"); do \
+	  name=$${id#motiongym/}; \
+	  ls docs/media/$${name}_*.gif >/dev/null 2>&1 && continue; \
+	  case $$name in Sweeper*) every=4;; DualArm*) every=5;; *) every=2;; esac; \
+	  MUJOCO_GL=egl $(BIN)/motiongym record $$id --seed 1 --every $$every --out docs/media || exit 1; \
+	done
 
 # Ray (the optional extra motiongym[ray]: `motiongym sweep`, `motiongym rllib`): installs
 # it, then runs tests/agents/test_ray.py with its slow tests (a local Ray head on

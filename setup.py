@@ -15,9 +15,18 @@ PACKAGE_DIRS = {
     "motiongym.configs": "configs",
 }
 
+# Folders of data files, not of code. Python would import them as namespace packages,
+# so setuptools wants them named: listed here, their files go in as package data.
+DATA_PACKAGES = [
+    "motiongym.agents.models.pretrained",  # shipped models: pretrained/<ID>/<label>/
+    "motiongym.configs.rllib",  # RLlib's settings
+    "motiongym.configs.zoo",  # rl-zoo3's settings
+]
+
 packages = list(PACKAGE_DIRS)
 for name, folder in PACKAGE_DIRS.items():
     packages += [f"{name}.{sub}" for sub in find_packages(folder)]
+packages += DATA_PACKAGES
 
 setup(
     packages=packages,
@@ -25,9 +34,8 @@ setup(
     package_data={
         "motiongym": ["py.typed"],
         "": ["*.txt", "*.png", "*.yml", "*.yaml", "*.json", "*.zip", "*.npz"],
-        # shipped models: pretrained/<ID>/<label>/ are folders, not packages
-        "motiongym.agents.models": ["pretrained/*/*/*"],
-        # folders of YAML files, not packages: rl-zoo3's and RLlib's settings
-        "motiongym.configs": ["zoo/*.yml", "rllib/*.yml"],
+        "motiongym.agents.models.pretrained": ["*/*/*"],
+        "motiongym.configs.rllib": ["*.yml"],
+        "motiongym.configs.zoo": ["*.yml"],
     },
 )

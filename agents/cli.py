@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -225,6 +226,10 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
         console.print(f"wrote {path}")
 
 
+# Gymnasium's warning on making an ID that has a newer version.
+OUT_OF_DATE = r".*The environment motiongym/\w+-v\d+ is out of date"
+
+
 def cmd_compare(args: argparse.Namespace) -> None:
     from motiongym.agents.evaluation.report import (
         comparison_summary,
@@ -238,16 +243,19 @@ def cmd_compare(args: argparse.Namespace) -> None:
         raise UsageError("compare takes an environment ID or --all, not both")
     env_ids = ENV_IDS if args.all else [check_env_id(args.env_id)]
     written: dict[str, list[Path]] = {}
-    for env_id in env_ids:
-        policies = args.policies or available_policies(env_id)
-        if not policies:
-            console.print(f"{env_id}: no policies to compare")
-            continue
-        evaluations = _evaluations(env_id, policies, args)
-        console.print(comparison_table(evaluations))
-        written[env_id] = write_comparison(evaluations, args.out, short_name(env_id))
-        for path in written[env_id]:
-            console.print(f"wrote {path}")
+    with warnings.catch_warnings():
+        if args.all:  # old versions are compared on purpose: Gymnasium's note on each is noise
+            warnings.filterwarnings("ignore", OUT_OF_DATE, DeprecationWarning)
+        for env_id in env_ids:
+            policies = args.policies or available_policies(env_id)
+            if not policies:
+                console.print(f"{env_id}: no policies to compare")
+                continue
+            evaluations = _evaluations(env_id, policies, args)
+            console.print(comparison_table(evaluations))
+            written[env_id] = write_comparison(evaluations, args.out, short_name(env_id))
+            for path in written[env_id]:
+                console.print(f"wrote {path}")
     if len(env_ids) > 1 and written:
         console.print(comparison_summary(written, args.out, args.episodes))
 

@@ -36,7 +36,9 @@ class HumanWindow:
 
     matplotlib picks an interactive backend (TkAgg where tkinter exists, Qt
     where installed) when a display is present; ``plt.pause`` draws the frame
-    and runs the window's events for one frame period.
+    and runs the window's events for one frame period. Under a non-interactive
+    backend (``MPLBACKEND=Agg``: no window to show) the frame is drawn on the
+    figure's canvas only.
     """
 
     def __init__(self, title: str, fps: float) -> None:
@@ -56,11 +58,19 @@ class HumanWindow:
             axes = self.figure.add_axes((0.0, 0.0, 1.0, 1.0))
             axes.set_axis_off()
             self.image = axes.imshow(frame)
-            self._plt.show(block=False)
+            if self._interactive():
+                self._plt.show(block=False)
         else:
             self.image.set_data(frame)
-        self._plt.pause(self.period)
+        if self._interactive():
+            self._plt.pause(self.period)
+        else:
+            self.figure.canvas.draw()
         self.shown += 1
+
+    def _interactive(self) -> bool:
+        """Whether the figure's backend has windows (a GUI framework behind its canvas)."""
+        return getattr(self.figure.canvas, "required_interactive_framework", None) is not None
 
     def close(self) -> None:
         if self.figure is not None:

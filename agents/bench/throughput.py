@@ -261,7 +261,7 @@ def _period(ms: float | None) -> str:
 
 
 def markdown(results: dict[str, Any]) -> str:
-    """The environment table as Markdown (for the README)."""
+    """The environment table as Markdown (docs/throughput.md holds the latest)."""
     refs = results["references"]
     lines = [
         f"Measured on: {results['machine']}. References (timed in turns with each ID; "

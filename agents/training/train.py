@@ -41,6 +41,7 @@ import shlex
 import shutil
 import sys
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -133,9 +134,12 @@ class StepsProgressBar(ProgressBarCallback):
 
     def _on_training_start(self) -> None:
         from stable_baselines3.common.callbacks import tqdm  # SB3's own (tqdm.rich)
+        from tqdm import TqdmExperimentalWarning
 
         total = steps_to_run(self.model, int(self.locals["total_timesteps"]))
-        self.pbar = tqdm(total=total - self.model.num_timesteps)
+        with warnings.catch_warnings():  # tqdm.rich calls itself experimental on every bar
+            warnings.simplefilter("ignore", TqdmExperimentalWarning)
+            self.pbar = tqdm(total=total - self.model.num_timesteps)
 
 
 class PlainCheckpoints(CheckpointCallback):

@@ -3,7 +3,8 @@
 The environment pages are generated here, before reading, from the registry:
 one page per registered ID with its registration (entry point, keywords, step
 limit), its scripted policies, the world's GIF from ``docs/media`` and the
-class docstring, which is the environment's full specification. So are a page
+class docstring, which is the environment's full specification (its Markdown
+``## Title`` lines are read as headings). So are a page
 per scripted policy (its paper, its module's and class's docstrings and those
 of the algorithm modules the module names) and a page per tutorial of
 ``docs/tutorials`` (its docstring, then its code).
@@ -70,11 +71,11 @@ def _page(env_id: str) -> str:
         f"Scripted policies (the paper's first): {policies}; ``random`` for every ID.",
         "",
     ]
-    gifs = sorted(MEDIA.glob(f"{name.split('-')[0]}-*.gif"))
-    if gifs:
-        target = GENERATED / gifs[0].name
-        shutil.copy2(gifs[0], target)
-        lines += [f".. image:: {gifs[0].name}", f"   :alt: one episode of {gifs[0].stem}", ""]
+    gifs = sorted(MEDIA.glob(f"{name}_*.gif"))  # this ID's own: `make media` makes them
+    if not gifs:
+        raise FileNotFoundError(f"no GIF of {env_id} in {MEDIA}: run `make media`")
+    shutil.copy2(gifs[0], GENERATED / gifs[0].name)
+    lines += [f".. image:: {gifs[0].name}", f"   :alt: one episode of {gifs[0].stem}", ""]
     lines += [f".. autoclass:: {module}.{cls}", "   :no-index:", ""]
     return "\n".join(lines)
 
@@ -171,5 +172,25 @@ def equations_as_literal_blocks(app, what, name, obj, options, lines: list[str])
             lines[i - 1] = before.rstrip() + " ::"
 
 
+HEADING = re.compile(r"^(\s*)#{2,4} +(\S.*?)\s*$")
+
+
+def markdown_headings_as_rubrics(app, what, name, obj, options, lines: list[str]) -> None:
+    """The environments' docstrings title their parts Markdown's way (``## Reward``);
+    inside an autodoc directive reStructuredText allows no section, so each becomes a
+    rubric (a heading outside the table of contents), with blank lines around it."""
+    out: list[str] = []
+    for line in lines:
+        match = HEADING.match(line)
+        if not match:
+            out.append(line)
+            continue
+        if out and out[-1].strip():
+            out.append("")
+        out += [f"{match[1]}.. rubric:: {match[2]}", ""]
+    lines[:] = out
+
+
 def setup(app) -> None:
+    app.connect("autodoc-process-docstring", markdown_headings_as_rubrics)
     app.connect("autodoc-process-docstring", equations_as_literal_blocks)

@@ -306,7 +306,9 @@ def test_training_that_diverges_is_one_line_and_says_what_is_left(capsys, tmp_pa
 
     monkeypatch.setattr(PPO, "learn", diverge)
     config = tmp_path / "tiny.yml"
-    config.write_text("ppo:\n  n_timesteps: 64\n  policy: MultiInputPolicy\n  n_steps: 32\n")
+    config.write_text(
+        "ppo:\n  n_timesteps: 64\n  policy: MultiInputPolicy\n  n_steps: 32\n  batch_size: 32\n"
+    )
     out = tmp_path / "runs"
     err = _error(capsys, ["train", SWEEPER, "--config", str(config), "--out", str(out)])
     assert "training stopped at step 0 (Expected parameter logits" in err

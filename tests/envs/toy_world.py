@@ -102,6 +102,7 @@ class ToyLineEnv(core.SystemEnv):
     Params = ToyParams
     metadata = {
         "render_modes": ["rgb_array"],
+        "render_fps": 10,  # Gymnasium's checker asks every rendering env for its frame rate
         "info_measures": {"is_success": "last", "cost": "sum"},
     }
 
