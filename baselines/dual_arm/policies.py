@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
@@ -41,15 +42,48 @@ from motiongym.envs.dual_arm.task import DT, LAYOUT, tasks_from_observation
 _ELAPSED = LAYOUT["elapsed"].start
 
 
-def environment_check(env_kwargs: dict[str, Any]) -> tuple[float, str]:
+def environment_check(env_kwargs: dict[str, Any], env_id: str | None = None) -> tuple[float, str]:
     """``(safety_margin, check)`` of the environment made with ``env_kwargs``: its margin
     (m) and its ``collision_check`` (``"swept"``: the motion between samples, v1;
-    ``"samples"``: the samples, v0), the rule of :mod:`motiongym.envs.dual_arm.collision`."""
-    params = params_for(env_kwargs)
+    ``"samples"``: the samples, v0), the rule of :mod:`motiongym.envs.dual_arm.collision`.
+
+    With ``env_id``, the ID's registered keywords stand wherever ``env_kwargs`` does not
+    give one: a policy told only ``{"control": ...}`` of ``DualArmCell-v1`` plans on v1's
+    check, not on the parameters' defaults (v0's samples, whose minimum delay can collide
+    between samples on v1)."""
+    registered = dict(gym.spec(env_id).kwargs) if env_id else {}
+    params = params_for({**registered, **env_kwargs})
     return params.safety_margin, params.collision_check
 
 
-class SchedulePolicy(ScriptedPolicy):
+class _EnvironmentCheck:
+    """``safety_margin`` and ``check`` of the environment a policy acts in, read from its
+    ``env_kwargs`` and, once :func:`motiongym.baselines.make_policy` has set it, the
+    registered keywords of its ``env_id`` (:func:`environment_check`)."""
+
+    env_kwargs: dict[str, Any]
+    env_id: str | None
+
+    def _environment(self) -> tuple[float, str]:
+        key = self.env_id
+        cached = self.__dict__.get("_environment_of")
+        if cached is None or cached[0] != key:
+            cached = (key, environment_check(self.env_kwargs, key))
+            self.__dict__["_environment_of"] = cached
+        return cached[1]
+
+    @property
+    def safety_margin(self) -> float:
+        """The environment's ``safety_margin`` (m)."""
+        return self._environment()[0]
+
+    @property
+    def check(self) -> str:
+        """The environment's ``collision_check``."""
+        return self._environment()[1]
+
+
+class SchedulePolicy(_EnvironmentCheck, ScriptedPolicy):
     """Base: plan robot 2's schedule on the episode's first step, then replay it.
 
     Args:
@@ -81,12 +115,16 @@ class SchedulePolicy(ScriptedPolicy):
         if action_space.shape not in ((1,), (2,)):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
-        # v1 checks the motion between samples: plan on the swept (conservative) map.
-        self.safety_margin, self.check = environment_check(self.env_kwargs)
-        self.margin = self.safety_margin + float(plan_margin)
+        self.plan_margin = float(plan_margin)
+        self._environment()  # a bad keyword is an error when the policy is made
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 
     verifiable = True  # False: the schedule is not meant to be collision free
+
+    @property
+    def margin(self) -> float:
+        """The clearance the planner demands: ``safety_margin + plan_margin`` (m)."""
+        return self.safety_margin + self.plan_margin
 
     def new_memory(self) -> dict[str, Any]:
         return {"schedule": None, "map": None}
@@ -233,7 +271,7 @@ class MinMakespanPolicy(SchedulePolicy):
         return found if found is not None else schedules.sequential(cmap)
 
 
-class EitherWaitsPolicy(ScriptedPolicy):
+class EitherWaitsPolicy(_EnvironmentCheck, ScriptedPolicy):
     """Either robot may wait: the shortest makespan over both robots' pure delays.
 
     Not the paper's method. The paper keeps robot 1 on its nominal schedule
@@ -268,7 +306,7 @@ class EitherWaitsPolicy(ScriptedPolicy):
                 f"either-waits moves both robots: it needs control='both' (an action of "
                 f"shape (2,)), got an action of shape {action_space.shape}"
             )
-        self.safety_margin, self.check = environment_check(self.env_kwargs)
+        self._environment()  # a bad keyword is an error when the policy is made
 
     def new_memory(self) -> dict[str, Any]:
         return {"lag_maps": None, "yields": None}
