@@ -284,11 +284,20 @@ class EitherWaitsPolicy(_EnvironmentCheck, ScriptedPolicy):
     would be done after it (:meth:`.lag_map.LagMap.finish`), and takes the order
     that ends first, robot 2 yielding on a tie (the paper's order).
     The running robot advances; the yielding one only when its ``w`` is 0.
-    From the episode's start this is ``min(max(N1, D2 + N2), max(N2, D1 + N1))``
-    steps, ``D2`` and ``D1`` each order's minimum pure delay
-    (:func:`.exact_delay.true_min_delay` in either order), tested against
-    brute force in the environment. Where neither order has a free wait (the
-    arms collide at rest) robot 1 runs and robot 2 waits.
+
+    Makespan. Following the chosen order for one step leaves that order's
+    plan, one step shorter, open from the next state, so the best finishing
+    time never moves later: the episode takes at most
+    ``min(max(N1, D2 + N2), max(N2, D1 + N1))`` steps, ``D2`` and ``D1`` each
+    order's minimum pure delay (:func:`.exact_delay.true_min_delay` in either
+    order; an order without one drops out). That is the makespan exactly
+    while one robot does all the waiting (tested against brute force in the
+    environment). It is shorter where, part-way, the other order finishes
+    sooner from the state reached: the policy then switches, and both robots
+    wait in the episode (robot 2 first, then robot 1, say). No closed form
+    covers those episodes: their makespan is what the re-planning reaches,
+    never more than the bound. Where neither order has a free wait (the arms
+    collide at rest) robot 1 runs and robot 2 waits.
 
     Needs ``control="both"``: under ``control="robot_2"`` robot 1 cannot yield.
     It plans on no map, so it takes none of the map policies' settings.
