@@ -141,6 +141,8 @@ class SchedulePolicy(_EnvironmentCheck, ScriptedPolicy):
             memory.update(map=cmap, replans=replans)
             if memory.get("reason"):  # no pure delay exists: nothing to re-plan
                 return plan
+            if memory.get("exact"):  # decided step by step on the environment's own rule
+                return plan
             if not (self.verify and self.verifiable) or not collision.schedule_collides(
                 self.check, traj1, traj2, plan.advances, self.safety_margin
             ):
@@ -192,8 +194,11 @@ class BoundaryFollowingPolicy(SchedulePolicy):
     On v0 on the paper's map. On v1 boundary following runs on a map of the
     environment's own step check and its delay is then made exact
     (:func:`.bracket.exact_delay_search`): the minimum pure delay on v1's
-    check; where none exists (``reason`` in the memory: e.g. the arms collide
-    at rest) robot 2 starts when robot 1 ends, reported as a fallback.
+    check, each of its steps decided by the environment's own rule, so it is
+    not verified again (the verification's halving alone would only repeat
+    it, at twice the search's cost); where none exists (``reason`` in the
+    memory: e.g. the arms collide at rest) robot 2 starts when robot 1 ends,
+    reported as a fallback.
 
     ``replan`` (not the paper's; for a DAgger teacher): instead of replaying
     the planned schedule by the clock, every step asks of the current state
@@ -232,6 +237,7 @@ class BoundaryFollowingPolicy(SchedulePolicy):
             traj1, traj2 = memory["tasks"]
             found = exact_delay_search(traj1, traj2, self.n_levels, memory["margin"])
             memory.update(result=found, fallback=found.delay is None, reason=found.reason)
+            memory["exact"] = found.delay is not None
             if found.delay is None:
                 return schedules.sequential(cmap)
             return schedules.delay_schedule(cmap, found.delay)
