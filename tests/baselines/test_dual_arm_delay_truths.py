@@ -58,9 +58,9 @@ def test_boundary_following_is_the_environments_minimum_and_clear(seed):
 
 
 @pytest.mark.slow
-def test_boundary_following_on_twenty_pairs():
+def test_boundary_following_on_eight_more_pairs():
     env = gym.make(V1)
-    for seed in range(610_000, 610_020):
+    for seed in range(610_000, 610_008):
         _check_against_the_environment(env, seed)
 
 

@@ -161,7 +161,6 @@ def test_either_waits_is_the_shorter_order_of_the_brute_force(env_id):
     assert longer == 3
 
 
-@pytest.mark.slow  # about 3 s: the policy's lag maps and two step tables of v1
 def test_either_waits_switching_order_finishes_before_the_closed_form():
     # Scene 100023 (v1): robot 2 waits first (36 steps), then robot 1 yields: robot 1
     # waiting from the start has no free pure delay, but after robot 2's wait it does,
