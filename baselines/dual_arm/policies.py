@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
@@ -41,15 +42,48 @@ from motiongym.envs.dual_arm.task import DT, LAYOUT, tasks_from_observation
 _ELAPSED = LAYOUT["elapsed"].start
 
 
-def environment_check(env_kwargs: dict[str, Any]) -> tuple[float, str]:
+def environment_check(env_kwargs: dict[str, Any], env_id: str | None = None) -> tuple[float, str]:
     """``(safety_margin, check)`` of the environment made with ``env_kwargs``: its margin
     (m) and its ``collision_check`` (``"swept"``: the motion between samples, v1;
-    ``"samples"``: the samples, v0), the rule of :mod:`motiongym.envs.dual_arm.collision`."""
-    params = params_for(env_kwargs)
+    ``"samples"``: the samples, v0), the rule of :mod:`motiongym.envs.dual_arm.collision`.
+
+    With ``env_id``, the ID's registered keywords stand wherever ``env_kwargs`` does not
+    give one: a policy told only ``{"control": ...}`` of ``DualArmCell-v1`` plans on v1's
+    check, not on the parameters' defaults (v0's samples, whose minimum delay can collide
+    between samples on v1)."""
+    registered = dict(gym.spec(env_id).kwargs) if env_id else {}
+    params = params_for({**registered, **env_kwargs})
     return params.safety_margin, params.collision_check
 
 
-class SchedulePolicy(ScriptedPolicy):
+class _EnvironmentCheck:
+    """``safety_margin`` and ``check`` of the environment a policy acts in, read from its
+    ``env_kwargs`` and, once :func:`motiongym.baselines.make_policy` has set it, the
+    registered keywords of its ``env_id`` (:func:`environment_check`)."""
+
+    env_kwargs: dict[str, Any]
+    env_id: str | None
+
+    def _environment(self) -> tuple[float, str]:
+        key = self.env_id
+        cached = self.__dict__.get("_environment_of")
+        if cached is None or cached[0] != key:
+            cached = (key, environment_check(self.env_kwargs, key))
+            self.__dict__["_environment_of"] = cached
+        return cached[1]
+
+    @property
+    def safety_margin(self) -> float:
+        """The environment's ``safety_margin`` (m)."""
+        return self._environment()[0]
+
+    @property
+    def check(self) -> str:
+        """The environment's ``collision_check``."""
+        return self._environment()[1]
+
+
+class SchedulePolicy(_EnvironmentCheck, ScriptedPolicy):
     """Base: plan robot 2's schedule on the episode's first step, then replay it.
 
     Args:
@@ -81,12 +115,16 @@ class SchedulePolicy(ScriptedPolicy):
         if action_space.shape not in ((1,), (2,)):
             raise ValueError(f"expected an action of shape (1,) or (2,), got {action_space.shape}")
         self.n_levels = int(n_levels)
-        # v1 checks the motion between samples: plan on the swept (conservative) map.
-        self.safety_margin, self.check = environment_check(self.env_kwargs)
-        self.margin = self.safety_margin + float(plan_margin)
+        self.plan_margin = float(plan_margin)
+        self._environment()  # a bad keyword is an error when the policy is made
         self.verify, self.replan_step, self.max_replans = verify, replan_step, max_replans
 
     verifiable = True  # False: the schedule is not meant to be collision free
+
+    @property
+    def margin(self) -> float:
+        """The clearance the planner demands: ``safety_margin + plan_margin`` (m)."""
+        return self.safety_margin + self.plan_margin
 
     def new_memory(self) -> dict[str, Any]:
         return {"schedule": None, "map": None}
@@ -102,6 +140,8 @@ class SchedulePolicy(ScriptedPolicy):
             plan = self.plan(cmap, memory)
             memory.update(map=cmap, replans=replans)
             if memory.get("reason"):  # no pure delay exists: nothing to re-plan
+                return plan
+            if memory.get("exact"):  # decided step by step on the environment's own rule
                 return plan
             if not (self.verify and self.verifiable) or not collision.schedule_collides(
                 self.check, traj1, traj2, plan.advances, self.safety_margin
@@ -154,8 +194,11 @@ class BoundaryFollowingPolicy(SchedulePolicy):
     On v0 on the paper's map. On v1 boundary following runs on a map of the
     environment's own step check and its delay is then made exact
     (:func:`.bracket.exact_delay_search`): the minimum pure delay on v1's
-    check; where none exists (``reason`` in the memory: e.g. the arms collide
-    at rest) robot 2 starts when robot 1 ends, reported as a fallback.
+    check, each of its steps decided by the environment's own rule, so it is
+    not verified again (the verification's halving alone would only repeat
+    it, at twice the search's cost); where none exists (``reason`` in the
+    memory: e.g. the arms collide at rest) robot 2 starts when robot 1 ends,
+    reported as a fallback.
 
     ``replan`` (not the paper's; for a DAgger teacher): instead of replaying
     the planned schedule by the clock, every step asks of the current state
@@ -194,6 +237,7 @@ class BoundaryFollowingPolicy(SchedulePolicy):
             traj1, traj2 = memory["tasks"]
             found = exact_delay_search(traj1, traj2, self.n_levels, memory["margin"])
             memory.update(result=found, fallback=found.delay is None, reason=found.reason)
+            memory["exact"] = found.delay is not None
             if found.delay is None:
                 return schedules.sequential(cmap)
             return schedules.delay_schedule(cmap, found.delay)
@@ -233,7 +277,7 @@ class MinMakespanPolicy(SchedulePolicy):
         return found if found is not None else schedules.sequential(cmap)
 
 
-class EitherWaitsPolicy(ScriptedPolicy):
+class EitherWaitsPolicy(_EnvironmentCheck, ScriptedPolicy):
     """Either robot may wait: the shortest makespan over both robots' pure delays.
 
     Not the paper's method. The paper keeps robot 1 on its nominal schedule
@@ -246,11 +290,20 @@ class EitherWaitsPolicy(ScriptedPolicy):
     would be done after it (:meth:`.lag_map.LagMap.finish`), and takes the order
     that ends first, robot 2 yielding on a tie (the paper's order).
     The running robot advances; the yielding one only when its ``w`` is 0.
-    From the episode's start this is ``min(max(N1, D2 + N2), max(N2, D1 + N1))``
-    steps, ``D2`` and ``D1`` each order's minimum pure delay
-    (:func:`.exact_delay.true_min_delay` in either order), tested against
-    brute force in the environment. Where neither order has a free wait (the
-    arms collide at rest) robot 1 runs and robot 2 waits.
+
+    Makespan. Following the chosen order for one step leaves that order's
+    plan, one step shorter, open from the next state, so the best finishing
+    time never moves later: the episode takes at most
+    ``min(max(N1, D2 + N2), max(N2, D1 + N1))`` steps, ``D2`` and ``D1`` each
+    order's minimum pure delay (:func:`.exact_delay.true_min_delay` in either
+    order; an order without one drops out). That is the makespan exactly
+    while one robot does all the waiting (tested against brute force in the
+    environment). It is shorter where, part-way, the other order finishes
+    sooner from the state reached: the policy then switches, and both robots
+    wait in the episode (robot 2 first, then robot 1, say). No closed form
+    covers those episodes: their makespan is what the re-planning reaches,
+    never more than the bound. Where neither order has a free wait (the arms
+    collide at rest) robot 1 runs and robot 2 waits.
 
     Needs ``control="both"``: under ``control="robot_2"`` robot 1 cannot yield.
     It plans on no map, so it takes none of the map policies' settings.
@@ -268,7 +321,7 @@ class EitherWaitsPolicy(ScriptedPolicy):
                 f"either-waits moves both robots: it needs control='both' (an action of "
                 f"shape (2,)), got an action of shape {action_space.shape}"
             )
-        self.safety_margin, self.check = environment_check(self.env_kwargs)
+        self._environment()  # a bad keyword is an error when the policy is made
 
     def new_memory(self) -> dict[str, Any]:
         return {"lag_maps": None, "yields": None}

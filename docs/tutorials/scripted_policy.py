@@ -8,7 +8,7 @@ state)``: motiongym's evaluation, ``compare`` and SB3's own
 single observations, a fresh memory at every episode start); a policy writes
 two methods, ``new_memory`` and ``act``.
 
-The example: in the dual-arm cell (``DualArmCell-v0``, two arms on fixed
+The example: in the dual-arm cell (``DualArmCell-v1``, two arms on fixed
 paths, collision avoided by timing), robot 2 waits a fixed number of steps
 and then runs, robot 1 runs at once. The paper's ``boundary-following``
 computes the smallest safe delay for each pair of tasks; a fixed delay is
@@ -33,7 +33,7 @@ from motiongym.agents.evaluation.report import comparison_table, console
 from motiongym.agents.models.predictors import load_predictor
 from motiongym.baselines import ScriptedPolicy
 
-ENV_ID = "motiongym/DualArmCell-v0"
+ENV_ID = "motiongym/DualArmCell-v1"
 
 
 @dataclass

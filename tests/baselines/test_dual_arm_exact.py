@@ -15,7 +15,7 @@ import motiongym  # noqa: F401
 from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.agents.reproduce.dual_arm_truth import at_rest_pair
 from motiongym.baselines import make_policy
-from motiongym.baselines.dual_arm import bracket, schedules
+from motiongym.baselines.dual_arm import bracket, exact_delay, schedules
 from motiongym.baselines.dual_arm.boundary_following import boundary_following
 from motiongym.baselines.dual_arm.collision_map import CollisionMap
 from motiongym.baselines.dual_arm.exact_delay import free_delays, step_table
@@ -161,3 +161,20 @@ def test_equal_to_the_brute_force_on_many_pairs():
 def test_bad_input_names_the_argument(kwargs, name):
     with pytest.raises(ValueError, match=name):
         bracket.exact_delay_search(*task.paper_case(), **kwargs)
+
+
+def test_a_policy_told_only_the_control_plans_on_its_ids_check():
+    # Told {"control": "both"} alone, the policy used to plan on the parameters' defaults
+    # (v0's samples): on this pair it chose 82, one step before v1's minimum 83, with no
+    # re-plan, and collided between samples (sampled distance 0.43 mm).
+    env = gym.make(V1)
+    policy = make_policy(V1, "boundary-following", env.observation_space, env.action_space,
+                         {"control": "both"})  # fmt: skip
+    assert (policy.check, policy.safety_margin) == ("swept", 0.0)
+    info = run_episode(env, policy, 610_030)
+    t1, t2 = env.unwrapped.world.tasks
+    assert policy.diagnostics()["delay"] == exact_delay.true_min_delay(t1, t2) == 83
+    assert info["is_success"]
+    v0 = make_policy(V1, "boundary-following", env.observation_space, env.action_space,
+                     {"collision_check": "samples"})  # fmt: skip
+    assert v0.check == "samples"  # what the caller says wins over the ID's registration

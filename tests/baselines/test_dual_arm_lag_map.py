@@ -9,6 +9,7 @@ import pytest
 from dual_arm_runs import run_policy, run_pure_delay
 
 from motiongym.baselines import make_policy
+from motiongym.baselines.dual_arm import exact_delay
 from motiongym.baselines.dual_arm.lag_map import LagMap
 from motiongym.envs.dual_arm.task import DT, LAYOUT, tasks_from_observation
 
@@ -158,3 +159,28 @@ def test_either_waits_is_the_shorter_order_of_the_brute_force(env_id):
         assert spans[0] <= spans[1] + 1e-9
         longer += spans[1] > spans[0] + 1e-9
     assert longer == 3
+
+
+def test_either_waits_switching_order_finishes_before_the_closed_form():
+    # Scene 100023 (v1): robot 2 waits first (36 steps), then robot 1 yields: robot 1
+    # waiting from the start has no free pure delay, but after robot 2's wait it does,
+    # and finishes sooner. Both robots wait; the makespan (228 steps) is below the pure
+    # delays' bound min(max(N1, D2 + N2), max(N2, D1 + N1)) = 264 (D1 none: 72 + 192).
+    env = gym.make(V1)
+    kwargs = dict(env.spec.kwargs)
+    either = make_policy(V1, "either-waits", env.observation_space, env.action_space, kwargs)
+    obs, _ = env.reset(seed=100023)
+    traj1, traj2 = env.unwrapped.world.tasks
+    actions, done = [], False
+    while not done:
+        action, _ = either.predict(obs)
+        actions.append(action)
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    waits = (np.array(actions) == 0).any(axis=0)
+    assert info["is_success"] and waits.all()  # both robots waited
+    d2 = exact_delay.true_min_delay(traj1, traj2)
+    assert exact_delay.true_min_delay(traj2, traj1) is None
+    bound = max(traj1.n_samples, d2 + traj2.n_samples)
+    assert (len(actions), bound) == (228, 264)
+    assert info["makespan"] == pytest.approx(len(actions) * DT)
