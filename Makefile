@@ -7,7 +7,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 EPISODES ?= 10
 
-.PHONY: install demo test test-slow lint models benchmarks fuzz docs media test-ray test-zoo
+.PHONY: install demo test test-slow studies lint models benchmarks fuzz docs media test-ray test-zoo
 
 $(STAMP): pyproject.toml setup.py
 	python3 -m venv $(VENV)
@@ -30,7 +30,12 @@ test: $(STAMP)
 	$(PYTEST)
 
 test-slow: $(STAMP)
-	$(PYTEST) -m slow
+	$(PYTEST) -m "slow and not study"
+
+# The held-out studies and learner ablations (marker `study`, tests/README.md): the
+# evidence behind docs/experiments' numbers, about an hour on two cores. Not part of CI.
+studies: $(STAMP)
+	$(PYTEST) -m study
 
 # The full property-based hostile-input run (tests/fuzz: every ID's keywords, reset
 # options and actions, the PettingZoo env, the policies' predict, model folders, config

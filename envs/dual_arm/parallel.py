@@ -33,8 +33,9 @@ class DualArmParallelEnv(ParallelEnv):
     ``TimeLimit`` wrapper in PettingZoo; an integer in [1, 10**6]). Each
     agent's action is checked as the Gymnasium environment checks its own
     (shape (1,), finite, clipped to [0, 1]); an action for a name that is not
-    an agent is an error naming it, as is a space asked for such a name. Reset options other than the task's
-    (``pairs``, and ``task``, its deprecated name) are ignored (PettingZoo's API
+    an agent is an error naming it, as is a space asked for such a name. Reset
+    options must be a dict; keys other than the task's (``pairs``, and ``task``,
+    its deprecated name) are ignored (PettingZoo's API
     test passes arbitrary ones). Other keywords go to the Gymnasium environment
     (``pairs``, ``safety_margin``, reward weights, ``collision_check``,
     ``render_mode``, ``render_size``).

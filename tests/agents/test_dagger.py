@@ -141,7 +141,7 @@ def test_dagger_refuses_spaces_it_cannot_fit():
         dagger(None, gym.make(REACH), None, iterations=-1)
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_dagger_iterations_lower_the_error_on_the_learners_own_states():
     """The ablation: the same labelling budget (20 episodes), spent on the teacher's states
     (iterations 0: behaviour cloning) or on the learner's (3 DAgger iterations of 5):
@@ -199,7 +199,7 @@ def _reach_v0_dagger(seed: int, replan: bool, squash: bool) -> tuple[float, floa
     return on_policy_error(model, env, teacher, range(100_000, 100_020), normalization)
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_reach_v0_learner_needs_the_replanning_teacher_and_the_squashed_error():
     """The ablation of configs/ExcavatorReach-v0-dagger.yml's two mechanisms at a small
     budget (seed 0): the full setting's held-out success is higher and its error to its

@@ -131,7 +131,7 @@ def _taught(env: gym.Env, teacher, seed: int) -> float:
     return on_policy_error(model, env, teacher, range(100_000, 100_020))[1]
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_the_learner_needs_the_map():
     """The ablation of configs/DualArmCell-v1-dagger.yml's memory at a small budget (10
     teacher and 10 learner episodes, seed 0): with the lag map the learner succeeds on

@@ -14,6 +14,7 @@ from stable_baselines3 import PPO, SAC
 from motiongym.agents import cli
 from motiongym.agents.cli import main
 from motiongym.agents.environments import long_episodes_note
+from motiongym.agents.evaluation import report
 from motiongym.agents.training.train import StepsProgressBar, steps_to_run
 
 SWEEPER = "motiongym/Sweeper-v0"
@@ -71,6 +72,9 @@ def test_the_progress_bar_ends_full_at_the_steps_that_ran():
 def test_compare_all_ends_with_what_it_wrote_and_where(capsys, monkeypatch, tmp_path):
     ids = ["motiongym/ExcavatorReach-v0", "motiongym/Excavator-v0"]
     monkeypatch.setattr(cli, "ENV_IDS", ids)
+    # The piped width wherever the tests run (pytest-xdist's workers set COLUMNS=80).
+    monkeypatch.delenv("COLUMNS", raising=False)
+    monkeypatch.setattr(report, "console", report.make_console())
     argv = ["compare", "--all", "--policies", "random", "--episodes", "1", "--max-steps", "3"]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

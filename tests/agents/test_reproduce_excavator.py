@@ -58,7 +58,7 @@ def test_files_written(results):
     assert r["speed"]["ik_solves_per_s_paper_case"] > 0
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_full_protocol(tmp_path):
     r = excavator.run(tmp_path, quick=False)
     assert r["random_poses"]["newton_rest_aligned"]["n"] == 1000

@@ -160,7 +160,7 @@ def test_localised_beats_dead_reckoning_on_the_room() -> None:
     assert all(a > b for a, b in zip(loc, dead, strict=True))
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
     """L, office, spiral (written here, never tuned on), seeds 0-2; measured mean (min):
     99.2 % (97.6 %) localised (a map per particle), 62.1 % (24.8 %) dead reckoning."""
@@ -175,7 +175,7 @@ def test_localised_beats_dead_reckoning_on_unseen_maps() -> None:
     assert np.min(ours) > np.min(ablation)
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_localised_beats_dead_reckoning_on_new_unseen_maps() -> None:
     """Corridors, pillars, generator maps from fresh seeds (apartment 4242, room 4243,
     maze 4244), seeds 0-1, heading 0.01 + slip 0.05. Measured, coverage at done:
@@ -230,7 +230,7 @@ LOS = (l_shape, office, spiral)
 OPEN = (office, NEW_UNSEEN["pillars"], NEW_UNSEEN["corridors"], spiral)
 
 
-@pytest.mark.slow
+@pytest.mark.study
 @pytest.mark.parametrize(
     ("ablation", "maps"),
     [
@@ -288,7 +288,7 @@ class NoSkip(PsaCwaPolicy):
     skip_ahead = False
 
 
-@pytest.mark.slow
+@pytest.mark.study
 def test_skipping_to_a_later_cell_of_the_plan_earns_its_place() -> None:
     """On the 56 development runs (docs/experiments/Sweeper-v1.md) the ablation gives 97.8 %
     mean, 65.3 % min against 99.5 %, 97.2 %; its two worst runs are checked here."""
