@@ -8,6 +8,9 @@ import pytest
 
 from motiongym.agents.reproduce import dual_arm
 
+# The quick protocol runs once per module (its fixture): the slow tier.
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def numbers(tmp_path_factory):

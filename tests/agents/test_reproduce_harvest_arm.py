@@ -5,10 +5,12 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from motiongym.agents.reproduce.harvest_arm import PAPER, VARIANTS, mcnemar, paired_scenes, run
 
 
+@pytest.mark.slow
 def test_quick_reproduction_prints_tables_and_writes_numbers_and_figures(tmp_path, capsys):
     numbers = run(tmp_path, quick=True)
     printed = capsys.readouterr().out

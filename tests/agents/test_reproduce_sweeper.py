@@ -11,6 +11,7 @@ from motiongym.agents.reproduce import experiments, reproduce
 from motiongym.agents.reproduce.sweeper import run
 
 
+@pytest.mark.slow
 def test_reproduce_sweeper_quick(tmp_path, capsys) -> None:
     results = run(tmp_path, quick=True)
     printed = capsys.readouterr().out
