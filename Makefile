@@ -73,13 +73,13 @@ test-ray: $(STAMP)
 # rl-zoo3 trains every block of configs/zoo/*.yml for a few hundred steps with its own
 # train script, and motiongym evaluates a zoo run (tests/agents/test_zoo_train.py). The zoo
 # is not a dependency (through moviepy it downgrades pillow): it goes in its own virtual
-# environment, .venv-zoo, never in .venv. About 4 min after the install.
+# environment, .venv-zoo, never in .venv. Its runs are spread over the cores like the tiers'.
 ZOO_VENV := .venv-zoo
 test-zoo:
 	test -x $(ZOO_VENV)/bin/python || python3 -m venv $(ZOO_VENV)
 	$(ZOO_VENV)/bin/python -m pip install --quiet torch==2.13.0
 	$(ZOO_VENV)/bin/python -m pip install --quiet -e ".[dev]" "rl_zoo3>=2.9,<3"
-	MUJOCO_GL=egl $(ZOO_VENV)/bin/pytest -q -m slow -p no:cacheprovider tests/agents/test_zoo_train.py
+	MUJOCO_GL=egl OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 $(ZOO_VENV)/bin/pytest -q -n $(PYTEST_WORKERS) -m slow -p no:cacheprovider tests/agents/test_zoo_train.py
 
 # The type check (mypy, [tool.mypy] in pyproject.toml) of envs/, baselines/ and agents/
 # reads the package through links in build/typecheck: setup.py maps the folders to the import name
