@@ -23,7 +23,7 @@ def test_psa_cwa_sweeps_every_family_whole_without_noise(family: str) -> None:
 
 @pytest.mark.study
 def test_psa_cwa_sweeps_the_evaluation_maps_whole_without_noise() -> None:
-    """Evaluation seeds 100000-100009 of every family (80 runs, about 15 s): 100 %
+    """Evaluation seeds 100000-100009 of every family (80 runs, about 20 s of CPU): 100 %
     coverage without a bump (issue 33's noise-free target for PSA + CWA)."""
     rows = [run(f, s, "none") for f in FAMILIES for s in range(100000, 100010)]
     assert all(r["coverage"] == 1.0 and r["bumps"] == 0 for r in rows), [
