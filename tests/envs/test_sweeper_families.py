@@ -149,6 +149,12 @@ def test_a_fixed_family_map_passes_the_env_checker(family: str) -> None:
     assert np.array_equal(env.unwrapped.scenario.obstacle, family_map(family, 100000, 3))
 
 
+def test_the_keywords_work_on_v0_too() -> None:
+    env = gym.make("motiongym/Sweeper-v0", map_family="offices", map_seed=3, map_size=(30, 50))
+    check_env(env.unwrapped, skip_render_check=True)
+    assert env.unwrapped.fixed.shape == (30, 50)
+
+
 def test_unset_map_seed_draws_a_map_per_reset_from_the_reset_seed() -> None:
     env = gym.make(ENV_ID, map_family="pillars", map_size=(30, 36))
     assert env.unwrapped.fixed is None
