@@ -144,6 +144,13 @@ class SweeperEnv(SystemEnv):
     ``map_name`` ("room", "apartment", "maze", "random", "random-room",
     "random-apartment", "random-maze"), ``map_file`` (a .txt or .png path,
     overrides map_name), ``grid`` (an (H, W) bool array, overrides both),
+    ``map_family`` (a generated family of
+    :mod:`~motiongym.envs.sweeper.families`: "narrow-corridors",
+    "corridors", "narrow-serpentine", "serpentine", "pillars", "offices",
+    "hall", "mixed"; overrides map_name), ``map_seed`` (an integer in
+    [0, 2**32 - 1]: one fixed map of the family; None: a map seed drawn
+    from each reset's generator), ``map_size`` ((rows, columns), at least
+    ``4 * robot_width + 6`` and at most 256 a side; None: (40, 60)),
     ``robot_width`` (cells, 3), ``sensor_range`` (cells beyond the footprint,
     default ``robot_width``), ``coarse`` (K, 16), ``heading_noise``,
     ``slip_noise``, ``sweep``, ``time``, ``bump`` (the reward weights),
@@ -163,6 +170,9 @@ class SweeperEnv(SystemEnv):
       the ``known`` observation key telling unknown from free.
     - v0: first version; the window sees through walls (kept as the
       see-through variant).
+
+    ``map_family``, ``map_seed`` and ``map_size`` were added to both without
+    a new version: left unset, they change nothing.
     """
 
     metadata = {

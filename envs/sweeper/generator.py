@@ -5,6 +5,10 @@ and returns a closed ``(H, W)`` bool obstacle map (True: obstacle). Openings
 (doors, corridors) are always wider than the robot so that the free space is
 mostly connected at robot scale; small pockets may remain, and the
 environment's coverage target counts only what the robot can reach.
+
+The map families of held-out studies (corridors of the robot's width,
+serpentines, pillar fields, offices, halls, mixed plans; every map sealed to
+be connected at robot scale) are in :mod:`motiongym.envs.sweeper.families`.
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ from motiongym.envs.core import (
     check_weight,
     params_from_kwargs,
 )
-from motiongym.envs.sweeper import generator, maps
+from motiongym.envs.sweeper import families, generator, maps
 
 MAP_CHOICES = (*maps.SHIPPED_MAPS, "random", *(f"random-{k}" for k in generator.KINDS))
 MAX_ROBOT_WIDTH = 10  # cells
@@ -49,6 +49,20 @@ class SweeperParams:
     grid           None      an (H, W) array of bools or finite numbers
                              (nonzero: obstacle), at most 256 a side;
                              overrides both
+    map_family     None      None or a family of
+                             :mod:`~motiongym.envs.sweeper.families`
+                             ("narrow-corridors", "corridors",
+                             "narrow-serpentine", "serpentine", "pillars",
+                             "offices", "hall", "mixed"); overrides
+                             ``map_name``; not with ``grid`` or ``map_file``
+    map_seed       None      None or an integer in [0, 2**32 - 1]: the map
+                             of ``map_family`` drawn from it, fixed for every
+                             episode; None: each reset draws a map seed from
+                             the episode's generator. Only with ``map_family``
+    map_size       None      None or (rows, columns), integers in
+                             [4 * robot_width + 6, 256]; None: (40, 60), each
+                             side raised to 4 * robot_width + 6 where shorter.
+                             Only with ``map_family``
     robot_width    3         integer cells in [1, 10]
     sensor_range   None      integer cells in [1, 16] beyond the footprint;
                              None: ``robot_width``
@@ -86,6 +100,9 @@ class SweeperParams:
     map_name: str = "room"
     map_file: str | os.PathLike | None = None
     grid: Any = None
+    map_family: str | None = None  # a generated family (families.FAMILIES)
+    map_seed: int | None = None  # in [0, families.MAX_MAP_SEED]; None: drawn per episode
+    map_size: tuple[int, int] | None = None  # rows, columns (cells); None: (40, 60)
     robot_width: int = 3  # cells
     # cells beyond the footprint; None given: robot_width (an int after __post_init__)
     sensor_range: int = None  # type: ignore[assignment]
@@ -113,6 +130,7 @@ class SweeperParams:
         R = w if self.sensor_range is None else self.sensor_range
         R = check_int("sensor_range", R, 1, MAX_SENSOR_RANGE)
         set_ = object.__setattr__
+        self._check_family(w)
         set_(self, "robot_width", w)
         set_(self, "sensor_range", R)
         set_(self, "coarse", check_int("coarse", self.coarse, 1, MAX_COARSE))
@@ -131,6 +149,30 @@ class SweeperParams:
                     f"render_size={self.render_size!r}, cell_pixels={px!r}"
                 )
         set_(self, "line_of_sight", check_bool("line_of_sight", self.line_of_sight))
+
+    def _check_family(self, w: int) -> None:
+        """Check ``map_family``, ``map_seed``, ``map_size`` (and that they come alone)."""
+        set_ = object.__setattr__
+        if self.map_family is None:
+            listed = ", ".join(map(repr, families.FAMILIES))
+            for name in ("map_seed", "map_size"):
+                if getattr(self, name) is not None:
+                    raise ArgumentError(
+                        f"{name} needs map_family (one of {listed}); got "
+                        f"{name}={getattr(self, name)!r} with map_family=None"
+                    )
+            return
+        check_choice("map_family", self.map_family, families.FAMILIES)
+        for name in ("grid", "map_file"):
+            if getattr(self, name) is not None:
+                raise ArgumentError(
+                    f"give map_family or {name}, not both; got map_family={self.map_family!r} "
+                    f"and {name}={getattr(self, name)!r}"
+                )
+        if self.map_seed is not None:
+            set_(self, "map_seed", check_int("map_seed", self.map_seed, 0, families.MAX_MAP_SEED))
+        if self.map_size is not None:
+            set_(self, "map_size", families.check_size(self.map_size, w))
 
     @classmethod
     def from_kwargs(cls, kwargs: Mapping[str, Any]) -> SweeperParams:

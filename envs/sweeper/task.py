@@ -31,7 +31,7 @@ import numpy as np
 from gymnasium import spaces
 
 from motiongym.envs.core import START, ArgumentError, Outcome, check_int, zero_terms
-from motiongym.envs.sweeper import generator, maps, occupancy
+from motiongym.envs.sweeper import families, generator, maps, occupancy
 from motiongym.envs.sweeper.measures import REWARD_TERMS, is_success, measures, reward_terms
 from motiongym.envs.sweeper.params import SweeperParams
 
@@ -61,9 +61,14 @@ class Scenario:
 
 
 def resolve_map(params: SweeperParams) -> np.ndarray | None:
-    """The fixed map of the environment (``grid``, ``map_file`` or a shipped
-    ``map_name``, in that order), or None when maps are procedural."""
+    """The fixed map of the environment (``grid``, ``map_file``, ``map_family`` with
+    ``map_seed``, or a shipped ``map_name``, in that order), or None when maps are
+    procedural."""
     w = params.robot_width
+    if params.map_family is not None:
+        if params.map_seed is None:
+            return None
+        return families.family_map(params.map_family, params.map_seed, w, params.map_size)
     if params.grid is not None:
         return maps.validate_map(params.grid, w, source="grid")
     if params.map_file is not None:
@@ -96,11 +101,21 @@ def sample_scenario(
     map_name: str,
     w: int,
     options: Mapping[str, Any] | None,
+    family: str | None = None,
+    size: tuple[int, int] | None = None,
 ) -> Scenario:
     """Draw the map (if procedural), the start and the heading; apply ``options``
-    (checked by :data:`OPTIONS`; None: none)."""
+    (checked by :data:`OPTIONS`; None: none).
+
+    A procedural map is of ``family`` (of ``size``) from a map seed drawn from
+    ``rng`` when a family is given, else of the ``map_name`` kind of
+    :func:`~motiongym.envs.sweeper.generator.random_map`.
+    """
     options = options or {}
-    if fixed is None:
+    if fixed is None and family is not None:
+        seed = int(rng.integers(0, families.MAX_MAP_SEED + 1))
+        obstacle = families.family_map(family, seed, w, size)
+    elif fixed is None:
         kind = map_name.split("-", 1)[1] if "-" in map_name else None
         obstacle = generator.random_map(rng, w, kind)
         while not occupancy.config_free(obstacle, w).any():  # pragma: no cover - rare
@@ -159,7 +174,9 @@ class SweeperTask:
 
     def sample(self, rng: np.random.Generator, options: Mapping[str, Any]) -> Scenario:
         p = self.params
-        return sample_scenario(rng, self.fixed, p.map_name, p.robot_width, options)
+        return sample_scenario(
+            rng, self.fixed, p.map_name, p.robot_width, options, p.map_family, p.map_size
+        )
 
     def begin(self, world: Any) -> Outcome:
         return self._outcome(world.state, zero_terms(REWARD_TERMS), False)

@@ -201,9 +201,7 @@ class SweeperVectorEnv(VectorEnv):
         for i, s in zip(idx.tolist(), seeds, strict=True):
             if s is not None or self._rngs[i] is None:
                 self._rngs[i] = seeding.np_random(s)[0]
-            sc = task.sample_scenario(
-                self._rngs[i], single.fixed, self.params.map_name, self.w, options
-            )
+            sc = single.task.sample(self._rngs[i], options or {})
             scenarios.append(sc)
         shape = np.array([sc.obstacle.shape for sc in scenarios]).max(axis=0)
         if g.ensure(int(shape[0]), int(shape[1])):
