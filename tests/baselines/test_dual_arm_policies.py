@@ -55,7 +55,7 @@ def test_makespans_ordered_on_the_paper_case():
     span = {}
     for name in ("boundary-following", "exhaustive-delay", "sequential", "min-makespan"):
         policy = make_policy(ID, name, env.observation_space, env.action_space, {})
-        info = run_policy(env, policy, 0, {"task": "paper"})
+        info = run_policy(env, policy, 0, {"pairs": "paper"})
         assert info["is_success"]
         span[name] = info["makespan"]
     assert span["boundary-following"] == span["exhaustive-delay"]
