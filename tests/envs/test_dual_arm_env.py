@@ -245,9 +245,12 @@ def test_obs_is_the_deprecated_name_of_the_layout():
     from motiongym.envs.dual_arm import world
 
     _warned.discard(("motiongym.envs.dual_arm.world", "OBS"))
+    _warned.discard(("motiongym.envs.dual_arm.world", "OBS_SIZE"))
     with pytest.warns(MotiongymDeprecationWarning, match="'OBS' is deprecated.*LAYOUT"):
         assert world.OBS == LAYOUT.slices
-    assert world.OBS["progress"] == slice(12, 14) and world.OBS_SIZE == LAYOUT.size == 94
+    assert world.OBS["progress"] == slice(12, 14)
+    with pytest.warns(MotiongymDeprecationWarning, match="'OBS_SIZE' is deprecated.*LAYOUT"):
+        assert world.OBS_SIZE == LAYOUT.size == 94
 
 
 def test_parallel_env_refuses_bad_options_and_unknown_agents():
