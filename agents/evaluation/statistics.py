@@ -240,7 +240,7 @@ def robust_statistics(
             values = [episode[key] for episode in evaluation.episodes]
             value, low, high = iqm_interval(values, strata)
             table[key] = {"iqm": value, "iqm_low": low, "iqm_high": high}
-            table[key]["runs"] = float(len(np.unique(strata)))
+            table[key]["runs"] = len(np.unique(strata))
             if base is None or key not in IMPROVEMENT_MEASURES or key not in base.measures:
                 continue
             other = [episode[key] for episode in base.episodes]

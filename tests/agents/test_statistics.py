@@ -197,3 +197,62 @@ def test_bad_input_is_refused_by_name(call, error, message):
 
     with pytest.raises(error, match=message):
         call(statistics)
+
+
+def _pooled(policy: str, returns: list[list[float]], successes: list[list[float]]) -> Evaluation:
+    """An evaluation of ``len(returns)`` runs on the same episode seeds (a pooled agent)."""
+    episodes = [
+        {"seed": 100 + i, "return": r, "length": 10, "is_success": s, "coverage": 0.5}
+        for run_returns, run_successes in zip(returns, successes, strict=True)
+        for i, (r, s) in enumerate(zip(run_returns, run_successes, strict=True))
+    ]
+    return Evaluation("motiongym/Sweeper-v0", policy, episodes, dict(UNITS))
+
+
+def test_robust_rows_give_iqm_and_improvement_over_the_paper():
+    from motiongym.agents.evaluation.report import robust_rows
+    from motiongym.agents.evaluation.statistics import robust_statistics
+
+    paper = _pooled("paper", [[1.0, 2.0, 3.0, 4.0]], [[1.0, 1.0, 0.0, 0.0]])
+    learned = _pooled("ppo", [[5.0, 6.0, 7.0, 8.0], [5.0, 6.0, 7.0, 9.0]], [[1.0] * 4] * 2)
+    robust = robust_statistics([paper, learned], "paper")
+    assert robust[1]["return"]["runs"] == 2 and robust[0]["return"]["runs"] == 1
+    assert robust[1]["return"]["iqm"] == 6.5  # 2 of 8 cut from each end: 6, 6, 7, 7
+    assert robust[1]["return"]["p_improvement"] == 1.0
+    assert robust[1]["is_success"]["p_improvement"] == 0.75  # 2 wins, 2 ties of 4 pairs
+    assert "p_improvement" not in robust[1]["length"]  # not a larger-is-better measure
+    rows = {row[0]: row[1:] for row in robust_rows([paper, learned], "paper", robust)}
+    (paper_iqm, learned_iqm) = rows["IQM return (reward)"]
+    assert paper_iqm.startswith("2.5 [") and learned_iqm.startswith("6.5 [")
+    low, high = robust[1]["return"]["iqm_low"], robust[1]["return"]["iqm_high"]
+    assert 5.0 <= low < 6.5 < high <= 9.0
+    assert "IQM is_success (rate)" not in rows  # a 0/1 rate's IQM is 0 or 1: read its mean
+    assert rows["P(return > paper's)"] == ["(reference)", "1 [1, 1]"]
+    assert rows["P(coverage > paper's)"] == ["(reference)", "0.5 [0.5, 0.5]"]
+    unrelated = robust_rows([learned], "paper")  # the paper's algorithm not compared
+    assert not any(row[0].startswith("P(") for row in unrelated)
+
+
+def test_compare_files_carry_the_robust_statistics(tmp_path):
+    import csv
+    import json
+
+    from motiongym.agents.evaluation.report import write_comparison
+
+    paper = _pooled("paper", [[1.0, 2.0, 3.0, 4.0]], [[1.0, 1.0, 0.0, 0.0]])
+    learned = _pooled("ppo", [[5.0, 6.0, 7.0, 8.0], [5.0, 6.0, 7.0, 9.0]], [[1.0] * 4] * 2)
+    write_comparison([paper, learned], tmp_path, "S", reference="paper")
+    with (tmp_path / "S_comparison.csv").open() as handle:
+        rows = {(r["policy"], r["measure"]): r for r in csv.DictReader(handle)}
+    row = rows[("ppo", "return")]
+    assert (row["runs"], row["episodes"], row["reference"]) == ("2", "8", "paper")
+    assert float(row["iqm"]) == 6.5 and float(row["p_improvement"]) == 1.0
+    assert float(row["mean"]) == pytest.approx(6.625)
+    assert rows[("ppo", "length")]["p_improvement"] == ""
+    data = json.loads((tmp_path / "S_comparison.json").read_text())
+    assert data[1]["reference"] == "paper"
+    assert data[1]["robust"]["is_success"]["p_improvement"] == 0.75
+    assert (
+        "P(return > paper's) | (reference) | 1 [1, 1] |"
+        in (tmp_path / "S_comparison.md").read_text()
+    )
