@@ -21,7 +21,7 @@ import csv
 import json
 import os
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -247,7 +247,7 @@ def write_statistics_csv(
         writer.writeheader()
         for evaluation, extra in zip(evaluations, robust, strict=True):
             for key, stats in evaluation.summary().items():
-                row = {"policy": evaluation.policy, "measure": key}
+                row: dict[str, Any] = {"policy": evaluation.policy, "measure": key}
                 row |= {"unit": evaluation.units.get(key, ""), "episodes": len(evaluation.episodes)}
                 row |= {k: stats[k] for k in ("mean", "low", "high")} | extra[key]
                 row["runs"] = int(extra[key]["runs"])
