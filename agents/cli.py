@@ -235,9 +235,12 @@ def cmd_compare(args: argparse.Namespace) -> None:
         comparison_summary,
         comparison_table,
         console,
+        robust_table,
         write_comparison,
     )
+    from motiongym.agents.evaluation.statistics import robust_statistics
     from motiongym.agents.models.predictors import available_policies
+    from motiongym.baselines import scripted_policies
 
     if args.all == (args.env_id is not None):
         raise UsageError("compare takes an environment ID or --all, not both")
@@ -252,8 +255,13 @@ def cmd_compare(args: argparse.Namespace) -> None:
                 console.print(f"{env_id}: no policies to compare")
                 continue
             evaluations = _evaluations(env_id, policies, args)
+            paper = next(iter(scripted_policies(env_id)), None)  # declared first
+            robust = robust_statistics(evaluations, paper)
             console.print(comparison_table(evaluations))
-            written[env_id] = write_comparison(evaluations, args.out, short_name(env_id))
+            console.print(robust_table(evaluations, paper, robust))
+            written[env_id] = write_comparison(
+                evaluations, args.out, short_name(env_id), paper, robust
+            )
             for path in written[env_id]:
                 console.print(f"wrote {path}")
     if len(env_ids) > 1 and written:

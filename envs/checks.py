@@ -329,3 +329,44 @@ def check_options(
         valid = ", ".join(validators) or "none"
         raise ArgumentError(f"unknown reset option(s) {unknown}; valid: {valid}")
     return {key: validators[key](f"options[{key!r}]", value) for key, value in options.items()}
+
+
+# ---------------------------------------------------------------- vector environments
+
+VECTOR_MEMORY_BOUND = 4 << 30  # bytes a natively vectorised world may hold for its sub-envs
+
+
+def check_num_envs(value: Any, bytes_per_env: int, memory_bound: int = VECTOR_MEMORY_BOUND) -> int:
+    """``num_envs`` of a natively vectorised world: an integer in ``[1, memory_bound //
+    bytes_per_env]``, ``bytes_per_env`` being the world's upper estimate of one
+    sub-environment's state and observations (its vector env's docstring derives it)."""
+    high = max(1, memory_bound // bytes_per_env)
+    try:
+        return check_int("num_envs", value, 1, high)
+    except ArgumentError as error:
+        raise ArgumentError(
+            f"{error} (the memory bound: {memory_bound / 2**30:g} GiB at up to "
+            f"{bytes_per_env / 1024:.1f} KiB per sub-environment with these parameters)"
+        ) from None
+
+
+def per_env(
+    name: str,
+    value: Any,
+    num_envs: int,
+    is_one: Callable[[Any], bool],
+    check: Callable[[str, Any], Any],
+) -> list[Any]:
+    """A reset option of a vector env, given either once for every sub-environment
+    (``is_one(value)`` true) or as a sequence of one value per sub-environment: the list
+    of ``num_envs`` values, each passed through ``check(name, value)`` (named
+    ``name[i]`` when per sub-environment). A sequence of another length is an
+    :class:`ArgumentError`."""
+    if is_one(value):
+        return [check(name, value)] * num_envs
+    allowed = f"one value for every sub-environment or a sequence of num_envs={num_envs} values"
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, (Sequence, np.ndarray)):
+        raise _fail(name, allowed, value)
+    if len(value) != num_envs:
+        raise ArgumentError(f"{name} must be {allowed}, got {len(value)} values: {value!r}")
+    return [check(f"{name}[{i}]", item) for i, item in enumerate(value)]

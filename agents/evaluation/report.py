@@ -6,17 +6,22 @@ otherwise, and a cell wider than its column folds onto the next line.
 Every 95 % interval is the summary's (:meth:`Evaluation.summary
 <motiongym.agents.evaluation.episodes.Evaluation.summary>`): ``mean ± half-width``
 where it is symmetric, ``mean [low, high]`` where it is not (Wilson's interval of a
-rate, or an interval clipped to [0, 1]). Figures label every panel with its measure
-and unit, clip a count's interval at 0, and leave out a measure that is 0 on every
-episode of every policy or that repeats an earlier measure's values.
+rate, or an interval clipped to [0, 1]). Beside it, a second table gives each
+measure's interquartile mean over runs x episodes and each policy's probability of
+improvement over the paper's algorithm, both with stratified bootstrap intervals
+(:func:`~motiongym.agents.evaluation.statistics.robust_statistics`). Figures label
+every panel with its measure and unit, clip a count's interval at 0, and leave out a
+measure that is 0 on every episode of every policy or that repeats an earlier
+measure's values.
 """
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -24,7 +29,13 @@ from rich.console import Console
 from rich.table import Table
 
 from motiongym.agents.evaluation.episodes import Evaluation
-from motiongym.agents.evaluation.statistics import COUNT_UNITS, RATE_UNITS
+from motiongym.agents.evaluation.statistics import (
+    BOOTSTRAP_RESAMPLES,
+    COUNT_UNITS,
+    IMPROVEMENT_MEASURES,
+    RATE_UNITS,
+    robust_statistics,
+)
 
 PIPED_WIDTH = 200  # columns of a table written to a pipe or a file
 
@@ -121,6 +132,131 @@ def comparison_markdown(evaluations: list[Evaluation]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _estimate(stats: dict[str, float], name: str) -> str:
+    return (
+        f"{_number(stats[name])} [{_number(stats[name + '_low'])}, "
+        f"{_number(stats[name + '_high'])}]"
+    )
+
+
+def robust_rows(
+    evaluations: list[Evaluation], reference: str | None, robust: list | None = None
+) -> list[list[str]]:
+    """One row per measure with its interquartile mean and stratified bootstrap interval
+    per policy (``IQM [low, high]``; not for a 0/1 ``rate``, whose IQM is 0 or 1: read
+    its mean and Wilson interval), then one per measure of
+    :data:`~motiongym.agents.evaluation.statistics.IMPROVEMENT_MEASURES` with each
+    policy's probability of improvement over ``reference`` (the paper's algorithm; the
+    reference's own cell says so). ``robust``: :func:`robust_statistics`' result, if
+    already computed."""
+    robust = robust if robust is not None else robust_statistics(evaluations, reference)
+    first = evaluations[0]
+    rows = [
+        [f"IQM {_unit(first, key)}"]
+        + [_estimate(r[key], "iqm") if key in r else "-" for r in robust]
+        for key in first.measures
+        if first.units.get(key, "") != "rate"
+    ]
+    for key in IMPROVEMENT_MEASURES:
+        if not any("p_improvement" in r.get(key, {}) for r in robust):
+            continue
+        rows.append(
+            [f"P({key} > {reference}'s)"]
+            + [
+                "(reference)"
+                if e.policy == reference
+                else _estimate(r[key], "p_improvement")
+                if "p_improvement" in r.get(key, {})
+                else "-"
+                for e, r in zip(evaluations, robust, strict=True)
+            ]
+        )
+    return rows
+
+
+def _robust_title(evaluations: list[Evaluation], reference: str | None) -> str:
+    against = (
+        f"probability of improvement over {reference}"
+        if any(e.policy == reference for e in evaluations)
+        else "no probability of improvement (the paper's algorithm is not compared)"
+    )
+    return (
+        f"{evaluations[0].env_id}: interquartile mean over runs x episodes and {against}; "
+        f"stratified bootstrap 95% intervals ({BOOTSTRAP_RESAMPLES} resamples, runs as strata)"
+    )
+
+
+def robust_table(
+    evaluations: list[Evaluation], reference: str | None, robust: list | None = None
+) -> Table:
+    """:func:`robust_rows` for the terminal."""
+    table = Table(title=_robust_title(evaluations, reference))
+    table.add_column("statistic")
+    for evaluation in evaluations:
+        table.add_column(evaluation.policy, justify="right")
+    for row in robust_rows(evaluations, reference, robust):
+        table.add_row(*row)
+    _fold(table)
+    return table
+
+
+def robust_markdown(
+    evaluations: list[Evaluation], reference: str | None, robust: list | None = None
+) -> str:
+    """:func:`robust_rows` as Markdown."""
+    names = [evaluation.policy for evaluation in evaluations]
+    lines = [
+        _robust_title(evaluations, reference),
+        "",
+        "| statistic | " + " | ".join(names) + " |",
+        "|---|" + "---:|" * len(names),
+    ]
+    lines += ["| " + " | ".join(row) + " |" for row in robust_rows(evaluations, reference, robust)]
+    return "\n".join(lines) + "\n"
+
+
+STATISTICS_COLUMNS = (
+    "policy",
+    "measure",
+    "unit",
+    "episodes",
+    "runs",
+    "mean",
+    "low",
+    "high",
+    "iqm",
+    "iqm_low",
+    "iqm_high",
+    "reference",
+    "p_improvement",
+    "p_improvement_low",
+    "p_improvement_high",
+)
+
+
+def write_statistics_csv(
+    evaluations: list[Evaluation], reference: str | None, path: Path, robust: list | None = None
+) -> Path:
+    """One row per policy and measure: :data:`STATISTICS_COLUMNS` (the mean and its 95 %
+    interval, the IQM and the probability of improvement over ``reference`` with their
+    bootstrap intervals; empty where it does not apply)."""
+    robust = robust if robust is not None else robust_statistics(evaluations, reference)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=STATISTICS_COLUMNS, restval="")
+        writer.writeheader()
+        for evaluation, extra in zip(evaluations, robust, strict=True):
+            for key, stats in evaluation.summary().items():
+                row: dict[str, Any] = {"policy": evaluation.policy, "measure": key}
+                row |= {"unit": evaluation.units.get(key, ""), "episodes": len(evaluation.episodes)}
+                row |= {k: stats[k] for k in ("mean", "low", "high")} | extra[key]
+                row["runs"] = int(extra[key]["runs"])
+                if "p_improvement" in extra[key]:
+                    row["reference"] = reference
+                writer.writerow(row)
+    return path
+
+
 def plotted_measures(evaluations: list[Evaluation]) -> list[str]:
     """The measures worth a panel: not 0 on every episode of every policy, and not
     a repeat of an earlier measure's values (the sweeper's ``steps`` is its length)."""
@@ -188,11 +324,13 @@ def comparison_summary(written: dict[str, list[Path]], out_dir: Path, episodes: 
         title=f"compared {len(written)} IDs on {episodes} episodes each: {n_files} files in "
         f"{out_dir}/ (per ID and policy: <ID>_comparison_<policy>.json and .csv)"
     )
-    for column in ("ID", "table (Markdown)", "figure", "all policies (JSON)"):
+    columns = ("ID", "tables (Markdown)", "figure", "all policies (JSON)", "statistics (CSV)")
+    for column in columns:
         table.add_column(column)
     for env_id, paths in written.items():
         by_suffix = {p.suffix: p.name for p in paths if p.stem.endswith("_comparison")}
-        table.add_row(env_id, *(by_suffix.get(s, "-") for s in (".md", ".png", ".json")))
+        suffixes = (".md", ".png", ".json", ".csv")
+        table.add_row(env_id, *(by_suffix.get(s, "-") for s in suffixes))
     _fold(table)
     return table
 
@@ -209,18 +347,37 @@ def write_evaluation(evaluation: Evaluation, out_dir: Path, stem: str) -> list[P
     return written
 
 
-def write_comparison(evaluations: list[Evaluation], out_dir: Path, stem: str) -> list[Path]:
+def write_comparison(
+    evaluations: list[Evaluation],
+    out_dir: Path,
+    stem: str,
+    reference: str | None = None,
+    robust: list | None = None,
+) -> list[Path]:
     """``compare``'s files: each policy's ``<stem>_comparison_<policy>.{json,csv}``, and
-    ``<stem>_comparison.{json,md,png}`` (the combined JSON, the table, the figure)."""
+    ``<stem>_comparison.{json,md,png,csv}`` (the combined JSON, the tables, the figure,
+    the statistics of :func:`write_statistics_csv`). Each policy's
+    entry of the combined JSON holds ``robust`` (:func:`robust_statistics` against
+    ``reference``, the paper's algorithm) and ``reference``."""
+    robust = robust if robust is not None else robust_statistics(evaluations, reference)
     written: list[Path] = []
     for evaluation in evaluations:
         name = f"{stem}_comparison_{_file_safe(evaluation.policy)}"
         written += evaluation.write(out_dir, name)
     combined = out_dir / f"{stem}_comparison.json"
-    combined.write_text(json.dumps([e.to_json() for e in evaluations], indent=2))
+    entries = [
+        {**e.to_json(), "reference": reference, "robust": r}
+        for e, r in zip(evaluations, robust, strict=True)
+    ]
+    combined.write_text(json.dumps(entries, indent=2))
     table = out_dir / f"{stem}_comparison.md"
-    table.write_text(comparison_markdown(evaluations))
-    written += [combined, table]
+    table.write_text(
+        comparison_markdown(evaluations) + "\n" + robust_markdown(evaluations, reference, robust)
+    )
+    statistics = write_statistics_csv(
+        evaluations, reference, out_dir / f"{stem}_comparison.csv", robust
+    )
+    written += [combined, table, statistics]
     written.append(comparison_figure(evaluations, out_dir / f"{stem}_comparison.png"))
     return written
 

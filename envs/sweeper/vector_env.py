@@ -5,12 +5,20 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from gymnasium.spaces.utils import flatdim
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from motiongym.envs.core import check_int, check_options, check_render_mode, zero_terms
-from motiongym.envs.sweeper import sight, task
+from motiongym.envs.checks import check_num_envs, per_env
+from motiongym.envs.core import (
+    START,
+    check_int,
+    check_options,
+    check_render_mode,
+    zero_terms,
+)
+from motiongym.envs.sweeper import families, sight, task
 from motiongym.envs.sweeper.env import SweeperEnv
 from motiongym.envs.sweeper.measures import (
     INFO_KEYS,
@@ -33,9 +41,52 @@ from motiongym.envs.sweeper.vector_state import (
     spread_info,
 )
 
-MAX_NUM_ENVS = 65_536  # about 1 GiB of state and observations on the largest maps
+PROCEDURAL_SIDE = 56  # cells: the largest side of a procedural map (generator.random_map)
+OVERHEAD_BYTES = 4096  # per sub-environment: its generator, scenario and path objects
 WINDOW_KEYS = ("sensed", "swept", "known")  # the planes of the kept windows, in order
 TURN = np.array([0, 1, 3], np.int64)  # heading change per action (forward, left, right) mod 4
+
+
+def bytes_per_env(single: SweeperEnv) -> int:
+    """An upper estimate of one sub-environment's memory, in bytes, for ``single``'s
+    parameters: its map of ``H x W`` cells (a fixed map's, else a generated family's
+    ``map_size``, else :data:`PROCEDURAL_SIDE` squared) padded by the sensor range
+    ``R`` to ``L = (H + 2R) (W + 2R)`` cells in
+    :class:`~motiongym.envs.sweeper.vector_state.BatchedGrids` (the sweep state and
+    reachability, 2 bytes a cell; with procedural maps also the obstacle and int32
+    block maps, 5 more), the scenario's four ``H x W`` bool maps, five float32 copies
+    of the observation (the current one and the
+    :class:`~motiongym.envs.sweeper.vector_state.ObservationPool`'s four), the four
+    float32 ``K x K`` coarse maps, three ``S x S`` window planes and
+    :data:`OVERHEAD_BYTES`."""
+    p = single.params
+    if single.fixed is not None:
+        H, W = single.fixed.shape
+    elif p.map_family is not None:
+        H, W = families.check_size(p.map_size, p.robot_width)
+    else:
+        H, W = (PROCEDURAL_SIDE,) * 2
+    R, K, S = p.sensor_range, p.coarse, p.window
+    cells = (H + 2 * R) * (W + 2 * R)
+    grids = (2 if single.fixed is not None else 7) * cells
+    observation = 4 * flatdim(single.observation_space)  # float32
+    return grids + 4 * H * W + 5 * observation + 16 * K * K + 3 * S * S + OVERHEAD_BYTES
+
+
+def _one_start(value: Any) -> bool:
+    """True for one ``start`` (None or a pair), False for a sequence of per-env starts."""
+    if not isinstance(value, (list, tuple, np.ndarray)) or len(value) == 0:
+        return True
+    return not (value[0] is None or isinstance(value[0], (list, tuple, np.ndarray)))
+
+
+def _one_value(value: Any) -> bool:
+    """True for one value, False for a list, tuple or array of per-env values."""
+    return not isinstance(value, (list, tuple, np.ndarray))
+
+
+def _mask(name: str, mask: Any) -> Any:
+    return mask  # checked in reset, where num_envs is known
 
 
 class SweeperVectorEnv(VectorEnv):
@@ -65,8 +116,13 @@ class SweeperVectorEnv(VectorEnv):
     :func:`motiongym.envs.sweeper.task.sample_scenario`, so every scenario
     (procedural map, start, heading) equals the separate environments' ones.
     ``reset(options=...)`` passes ``start`` / ``heading`` to every
-    sub-environment (as SyncVectorEnv does); ``options={"reset_mask": mask}``
-    resets only the masked ones.
+    sub-environment (as SyncVectorEnv does), or, given a sequence of one per
+    sub-environment (``start``: ``num_envs`` pairs or None; ``heading``:
+    ``num_envs`` integers or None), value ``i`` to sub-environment ``i``; a
+    sequence of another length is a ValueError naming the option.
+    ``options={"reset_mask": mask}`` resets only the masked ones (per-env
+    values are still indexed by sub-environment). A list of seeds must have
+    ``num_envs`` entries.
 
     ## Layout and limits
     All sub-environments share one padded map shape (the largest map seen;
@@ -74,7 +130,13 @@ class SweeperVectorEnv(VectorEnv):
     once. Odometry noise (``heading_noise``, ``slip_noise``) draws from each
     world's generator inside the step and is not batched: a non-zero value
     raises ValueError. Per-environment Python work happens only in resets.
-    ``num_envs`` is an integer in [1, 65536], ``max_episode_steps`` an
+    ``num_envs`` is an integer from 1 up to the memory bound: 4 GiB
+    (:data:`~motiongym.envs.checks.VECTOR_MEMORY_BOUND`) over
+    :func:`bytes_per_env`, the upper estimate of one sub-environment's memory
+    for the parameters given (60 KiB, so 69,897 sub-environments, with the
+    default parameters on procedural maps; 29 KiB on the shipped room). Anything
+    else (0, negative, a float, beyond the bound) is a ValueError naming
+    ``num_envs``, the value and the range. ``max_episode_steps`` is an
     integer >= 1; the other keywords are the single environment's, checked
     by :class:`~motiongym.envs.sweeper.params.SweeperParams`.
 
@@ -113,12 +175,12 @@ class SweeperVectorEnv(VectorEnv):
         render_mode: str | None = None,
         **kwargs: Any,
     ) -> None:
-        N = check_int("num_envs", num_envs, 1, MAX_NUM_ENVS)
         render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
         max_episode_steps = check_int("max_episode_steps", max_episode_steps, 1)
         # The single environment validates the keywords and holds the spaces.
         self._single = single = SweeperEnv(render_mode=render_mode, **kwargs)
         self.params = p = single.params
+        N = check_num_envs(num_envs, bytes_per_env(single))
         for name in ("heading_noise", "slip_noise"):
             if getattr(p, name):
                 raise ValueError(
@@ -172,8 +234,11 @@ class SweeperVectorEnv(VectorEnv):
         else:
             seeds = list(seed)
             if len(seeds) != N:
-                raise ValueError(f"reset got {len(seeds)} seeds for num_envs={N}")
-        options = check_options(options, {**task.OPTIONS, "reset_mask": lambda _, mask: mask})
+                raise ValueError(
+                    f"seed must be an integer, None or a list of num_envs={N} seeds, "
+                    f"got {len(seeds)} seeds: {seed!r}"
+                )
+        options = check_options(options, {**self._per_env_options, "reset_mask": _mask})
         mask = options.pop("reset_mask", None)
         if mask is None:
             idx = np.arange(N)
@@ -181,12 +246,13 @@ class SweeperVectorEnv(VectorEnv):
             mask = np.asarray(mask)
             if mask.shape != (N,) or mask.dtype != np.bool_ or not mask.any():
                 raise ValueError(
-                    f"options['reset_mask'] must be a bool array of shape ({N},) with a True"
+                    f"options['reset_mask'] must be a bool array of shape ({N},) with a True, "
+                    f"got shape {mask.shape}, dtype {mask.dtype}: {mask!r}"
                 )
             if not self._ready:
                 raise RuntimeError("call reset() without reset_mask first")
             idx = np.flatnonzero(mask)
-        self._reset_envs(idx, [seeds[i] for i in idx], options or None)
+        self._reset_envs(idx, [seeds[i] for i in idx], options)
         self._ready = True
         info = self._info(idx, zero_terms(REWARD_TERMS), np.zeros(len(idx), bool))
         if mask is not None:
@@ -194,14 +260,30 @@ class SweeperVectorEnv(VectorEnv):
         self._pool.record(None)
         return self._observation(), info
 
-    def _reset_envs(self, idx: np.ndarray, seeds: list, options: dict | None) -> None:
-        """Sample and load new episodes for sub-environments ``idx`` (Python per world)."""
+    @property
+    def _per_env_options(self) -> dict[str, Any]:
+        """The reset options' checks: one value for every sub-environment, or a list of
+        one per sub-environment (see the class docstring); each returns the list."""
+        N = self.num_envs
+
+        def start(name: str, value: Any) -> list:
+            return per_env(name, value, N, _one_start, task.OPTIONS[START])
+
+        def heading(name: str, value: Any) -> list:
+            return per_env(name, value, N, _one_value, task.OPTIONS["heading"])
+
+        return {START: start, "heading": heading}
+
+    def _reset_envs(self, idx: np.ndarray, seeds: list, options: dict[str, list]) -> None:
+        """Sample and load new episodes for sub-environments ``idx`` (Python per world);
+        ``options``: each reset option's list of one value per sub-environment."""
         single, g = self._single, self._grids
         scenarios = []
         for i, s in zip(idx.tolist(), seeds, strict=True):
             if s is not None or self._rngs[i] is None:
                 self._rngs[i] = seeding.np_random(s)[0]
-            sc = single.task.sample(self._rngs[i], options or {})
+            own = {key: values[i] for key, values in options.items()}
+            sc = single.task.sample(self._rngs[i], own)
             scenarios.append(sc)
         shape = np.array([sc.obstacle.shape for sc in scenarios]).max(axis=0)
         if g.ensure(int(shape[0]), int(shape[1])):
@@ -389,7 +471,7 @@ class SweeperVectorEnv(VectorEnv):
             arr = np.zeros_like(info[key])
             arr[di] = info[key][di]
             final_info[key], final_info[f"_{key}"] = arr, done.copy()
-        self._reset_envs(di, [None] * len(di), None)
+        self._reset_envs(di, [None] * len(di), {})
         changes["reset"].append(di)
         fresh = self._info(di, zero_terms(REWARD_TERMS), np.zeros(len(di), bool))
         for key in INFO_KEYS:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from motiongym.agents.evaluation import benchmarks
+from motiongym.agents.evaluation.statistics import robust_statistics
 
 ENV_ID = "motiongym/ExcavatorReach-v0"
 
@@ -19,6 +20,8 @@ def test_pooled_evaluation_holds_every_seed_episode(shipped_folder):
     evaluation, metrics = benchmarks.pooled_evaluation(shipped_folder)
     assert evaluation.policy == "ppo (from scratch, 2 seeds)"
     assert len(evaluation.episodes) == 2 * len(metrics["held_out_seeds"])
+    (robust,) = robust_statistics([evaluation])  # the training seeds are the strata
+    assert robust["return"]["runs"] == 2
 
 
 def test_benchmarks_rewrites_only_the_generated_part(one_shipped_id, tmp_path):
@@ -36,6 +39,11 @@ def test_benchmarks_rewrites_only_the_generated_part(one_shipped_id, tmp_path):
     header = next(line for line in generated.splitlines() if line.startswith("| measure"))
     assert "newton-raphson-reach" in header and "ppo (from scratch, 2 seeds)" in header
     assert "over 2 or 4 episodes per policy" in generated
+    robust = next(line for line in generated.splitlines() if line.startswith("| statistic"))
+    assert "newton-raphson-reach" in robust and "ppo (from scratch, 2 seeds)" in robust
+    assert "probability of improvement over newton-raphson-reach" in generated
+    assert "| IQM return (reward) |" in generated
+    assert "| P(return > newton-raphson-reach's) | (reference) |" in generated
     assert (tmp_path / "docs" / "benchmarks" / "ExcavatorReach-v0.png").is_file()
     assert "](docs/benchmarks/ExcavatorReach-v0.png)" in generated
 

@@ -87,7 +87,7 @@ def test_compare_all_ends_with_what_it_wrote_and_where(capsys, monkeypatch, tmp_
     for env_id in ids:
         name = env_id.split("/")[1]
         assert env_id in summary
-        for suffix in ("md", "png", "json"):
+        for suffix in ("md", "png", "json", "csv"):
             assert f"{name}_comparison.{suffix}" in summary
             assert (tmp_path / f"{name}_comparison.{suffix}").is_file()
 

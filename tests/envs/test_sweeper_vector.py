@@ -8,8 +8,10 @@ import pytest
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 import motiongym  # noqa: F401
+from motiongym.envs.checks import VECTOR_MEMORY_BOUND
+from motiongym.envs.sweeper.env import SweeperEnv
 from motiongym.envs.sweeper.generator import empty_room
-from motiongym.envs.sweeper.vector_env import SweeperVectorEnv
+from motiongym.envs.sweeper.vector_env import SweeperVectorEnv, bytes_per_env
 
 ENV_ID = "motiongym/Sweeper-v0"
 
@@ -260,10 +262,6 @@ def test_bad_construction_raises() -> None:
         SweeperVectorEnv(num_envs=2, slip_noise=0.1)
     with pytest.raises(ValueError, match="map_name must be one of"):
         SweeperVectorEnv(num_envs=2, map_name="castle")
-    with pytest.raises(ValueError, match=r"num_envs must be an integer in \[1, 65536\], got 0"):
-        SweeperVectorEnv(num_envs=0)
-    with pytest.raises(ValueError, match="num_envs must be an integer"):
-        SweeperVectorEnv(num_envs=2.5)
     with pytest.raises(ValueError, match="max_episode_steps must be an integer >= 1, got None"):
         SweeperVectorEnv(num_envs=2, max_episode_steps=None)
     with pytest.raises(RuntimeError, match="reset"):
@@ -363,3 +361,107 @@ def test_state_of_each_sub_environment_equals_the_single_env_state(line_of_sight
                 continue
             np.testing.assert_array_equal(a, b, err_msg=field.name)
         assert got.n_overswept > 0 and got.known_obstacles.any()
+
+
+# --- bad input: num_envs and per-env reset options ---
+
+LARGE = {"sensor_range": 16, "robot_width": 10, "coarse": 64}  # the largest window and maps
+
+
+@pytest.mark.parametrize("kwargs", [{}, {"map_name": "random"}, LARGE])
+@pytest.mark.parametrize("num_envs", [0, -1, 2.5, "4", True, None, "bound + 1"])
+def test_num_envs_outside_its_range_is_one_clear_error(kwargs, num_envs) -> None:
+    """0, negative, not an integer, or beyond the memory bound (4 GiB over the estimate of
+    one sub-environment for these parameters): a ValueError naming num_envs, the value
+    and the range, from the class and through gym.make_vec alike."""
+    bound = VECTOR_MEMORY_BOUND // bytes_per_env(SweeperEnv(**kwargs))
+    value = bound + 1 if num_envs == "bound + 1" else num_envs
+    message = (
+        rf"num_envs must be an integer in \[1, {bound}\], got {value!r} "
+        r"\(the memory bound: 4 GiB at up to \d+\.\d KiB per sub-environment"
+    )
+    with pytest.raises(ValueError, match=message):
+        SweeperVectorEnv(num_envs=value, **kwargs)
+    with pytest.raises(ValueError, match=message):
+        gym.make_vec(ENV_ID, num_envs=value, vectorization_mode="vector_entry_point", **kwargs)
+
+
+def test_the_memory_bound_holds_for_the_bytes_each_sub_environment_takes() -> None:
+    """bytes_per_env is an upper estimate: the traced memory grows by less per added
+    sub-environment (reset and a few steps, a fixed map and procedural ones), and by more
+    than half of it, so the bound is not loose by more than a factor of two."""
+    import tracemalloc
+
+    for kwargs in ({"map_name": "room"}, {"map_name": "random"}):
+        peaks = []
+        for n in (16, 80):
+            tracemalloc.start()
+            env = SweeperVectorEnv(num_envs=n, **kwargs)
+            env.reset(seed=0)
+            for _ in range(3):
+                env.step(np.zeros(n, np.int64))
+            peaks.append(tracemalloc.get_traced_memory()[1])
+            tracemalloc.stop()
+            env.close()
+            del env
+        per_env = (peaks[1] - peaks[0]) / 64
+        estimate = bytes_per_env(SweeperEnv(**kwargs))
+        assert 0.5 * estimate < per_env < estimate, (kwargs, per_env, estimate)
+    assert VECTOR_MEMORY_BOUND // bytes_per_env(SweeperEnv(map_name="random")) == 69_897
+
+
+def test_per_env_reset_options_reach_their_own_sub_environment() -> None:
+    """A list of num_envs starts or headings gives value i to sub-environment i, as a
+    single environment reset with seed + i and that value (None: sampled)."""
+    starts, headings = [(2, 3), None, (4, 5)], [1, 2, None]
+    env = SweeperVectorEnv(3, 30)
+    observation, _ = env.reset(seed=0, options={"start": starts, "heading": headings})
+    for i in range(3):
+        single = SweeperEnv()
+        options = {"start": starts[i], "heading": headings[i]}
+        expected, _ = single.reset(seed=i, options=options)
+        for key, value in expected.items():
+            np.testing.assert_array_equal(observation[key][i], value, err_msg=f"{i} {key}")
+    assert observation["pose"][0, :3].tolist() == [2, 3, 1]
+    assert observation["pose"][2, :2].tolist() == [4, 5]
+    mask = np.array([False, True, False])
+    observation, _ = env.reset(seed=9, options={"heading": [0, 3, 0], "reset_mask": mask})
+    assert observation["pose"][1, 2] == 3  # indexed by sub-environment under a mask
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        (
+            {"start": [(2, 3), (2, 4)]},
+            r"options\['start'\] must be one value for every sub-environment or a sequence "
+            r"of num_envs=3 values, got 2 values: \[\(2, 3\), \(2, 4\)\]",
+        ),
+        ({"heading": [0, 1, 2, 3]}, r"options\['heading'\] .* num_envs=3 values, got 4 values"),
+        ({"heading": np.zeros(2, int)}, r"options\['heading'\] .* got 2 values"),
+        ({"heading": []}, r"options\['heading'\] .* got 0 values"),
+        ({"heading": 4}, r"options\['heading'\] must be an integer in \[0, 3\], got 4"),
+        ({"heading": [0, 9, 0]}, r"options\['heading'\]\[1\] must be an integer in \[0, 3\]"),
+        ({"start": [(2, 3), None, (1,)]}, r"options\['start'\]\[2\] must be \(row, col\)"),
+        (
+            {"reset_mask": np.ones(2, bool)},
+            r"options\['reset_mask'\] must be a bool array of shape \(3,\) with a True, "
+            r"got shape \(2,\)",
+        ),
+    ],
+)
+def test_per_env_reset_options_of_the_wrong_length_are_one_clear_error(options, match) -> None:
+    env = SweeperVectorEnv(3, 30)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=match):
+        env.reset(seed=0, options=options)
+    with pytest.raises(ValueError, match=r"seed must be .* num_envs=3 seeds, got 2 seeds"):
+        env.reset(seed=[1, 2])
+
+
+def test_the_memory_bound_reads_a_generated_familys_map_size():
+    from motiongym.envs.sweeper.vector_env import bytes_per_env
+
+    small = gym.make("motiongym/Sweeper-v1", map_family="hall").unwrapped
+    large = gym.make("motiongym/Sweeper-v1", map_family="hall", map_size=(200, 200)).unwrapped
+    assert bytes_per_env(large) > 5 * bytes_per_env(small)  # 200 x 200 cells against 40 x 60
