@@ -1,0 +1,121 @@
+"""The classical coverage references on Sweeper-v1: their mechanisms, their coverage.
+
+Boustrophedon cellular decomposition (Choset & Pignon 1997; Choset 2000), BA*
+(Viet et al. 2013) and Spiral-STC (Gabriely & Rimon 2002), each online on the
+robot's own map (baselines/sweeper/online.py).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import motiongym  # noqa: F401
+from motiongym.agents.evaluation.episodes import run_episode
+from motiongym.agents.models.predictors import available_policies
+from motiongym.baselines.registry import make_policy
+from motiongym.baselines.sweeper import boustrophedon as bcd
+from motiongym.envs.sweeper import occupancy
+from motiongym.envs.sweeper.generator import empty_room
+
+ENV_ID = "motiongym/Sweeper-v1"
+CLASSICAL = ("boustrophedon",)
+
+
+def _run(name: str, seed: int = 0, options: dict | None = None, **kwargs: Any):
+    """One episode until the policy declares itself done (or the env ends it): the last
+    info, the actions, the policy's diagnostics and the env's state."""
+    env = gym.make(ENV_ID, max_episode_steps=6000, **kwargs)
+    policy = make_policy(
+        ENV_ID, name, env.observation_space, env.action_space, {**gym.spec(ENV_ID).kwargs, **kwargs}
+    )
+    seen: dict[str, Any] = {"actions": []}
+
+    def hook(step) -> bool:
+        seen["actions"].append(int(step.action))
+        seen["info"] = step.info
+        return bool(policy.diagnostics().get("done"))
+
+    run_episode(env, policy, seed, hook=hook, options=options)
+    state = env.unwrapped.state
+    env.close()
+    return seen["info"], seen["actions"], policy.diagnostics(), state
+
+
+def _pillar_room() -> np.ndarray:
+    """A 24 x 30 room with a 6 x 8 pillar in its middle."""
+    grid = empty_room(24, 30)
+    grid[9:15, 11:19] = True
+    return grid
+
+
+# --------------------------------------------------------------- boustrophedon
+def test_slice_events_split_at_a_pillar_merge_past_it_and_close_at_a_wall() -> None:
+    """``next_slice`` on the pillar room's configurations (w = 3): from the slice left of
+    the pillar the next slice's free interval splits in two (above and below it); past
+    it two intervals merge into one; along the pillar a slice continues; at the east
+    wall the cell is closed."""
+    cfree = occupancy.config_free(_pillar_room(), 3)
+    whole = (1, 20)  # rows of free configurations of a slice clear of the pillar
+    assert bcd.intervals(cfree[:, 6]) == [whole]
+    event, k, js = bcd.next_slice(cfree, 6, whole, +1, 3)
+    assert (event, k, js) == ("split", 3, [(1, 6), (15, 20)])
+    event, k, js = bcd.next_slice(cfree, 5, whole, +1, 3)
+    assert (event, k, js) == ("continue", 3, [whole])  # col 8 is clear of the pillar
+    event, k, js = bcd.next_slice(cfree, 12, (1, 6), +1, 3)
+    assert (event, k, js) == ("continue", 3, [(1, 6)])
+    event, k, js = bcd.next_slice(cfree, 16, (15, 20), +1, 3)
+    assert (event, k, js) == ("merge", 3, [whole])
+    event, k, js = bcd.next_slice(cfree, 17, (15, 20), +1, 3)
+    assert (event, k, js) == ("merge", 2, [whole])  # col 19: the first slice past the pillar
+    event, k, js = bcd.next_slice(cfree, 26, whole, +1, 3)
+    assert (event, k, js) == ("closed", 0, [])
+    event, k, js = bcd.next_slice(cfree, 25, whole, +1, 3)
+    assert (event, k, js) == ("continue", 1, [whole])  # the last lane hugs the wall
+
+
+def test_boustrophedon_lanes_alternate_in_a_cell_and_cells_open_at_critical_points() -> None:
+    """In the pillar room: every cell's consecutive lanes run opposite ways, a split (IN)
+    and a merge (OUT) each open a cell, and the room is swept whole without a bump."""
+    info, _, diag, _ = _run("boustrophedon", options={"start": (18, 2), "heading": 0},
+                            grid=_pillar_room())  # fmt: skip
+    assert info["coverage"] == 1.0 and info["is_success"] and info["bumps"] == 0
+    events = [cell[0] for cell in diag["cells"]]
+    assert events[0] == "start" and "split" in events and "merge" in events
+    by_cell: dict[int, list] = {}
+    for cell, col, heading, _, _ in diag["lanes"]:
+        by_cell.setdefault(cell, []).append((col, heading))
+    assert max(len(v) for v in by_cell.values()) >= 3
+    for lanes in by_cell.values():
+        for (c0, h0), (c1, h1) in zip(lanes[:-1], lanes[1:], strict=True):
+            assert {h0, h1} == {1, 3}  # north then south or south then north
+            assert 1 <= abs(c1 - c0) <= 3  # one robot width on, less at a wall
+    # a cell the split opened lies beside the pillar (rows 9-14), above or below it
+    split = [interval for e, _, interval, _ in diag["cells"] if e == "split"]
+    assert all(hi <= 6 or lo >= 15 for lo, hi in split)
+
+
+# ------------------------------------------------------------------ all of them
+@pytest.mark.parametrize("name", CLASSICAL)
+@pytest.mark.parametrize("map_name", ["room", "apartment", "maze"])
+def test_classical_sweeps_every_reachable_cell_of_the_shipped_maps(name, map_name) -> None:
+    """No noise: coverage 1.0 when the policy declares itself done, no bump."""
+    info, _, diag, _ = _run(name, seed=0, map_name=map_name)
+    assert info["coverage"] == 1.0 and info["bumps"] == 0, (info["coverage"], info["bumps"])
+
+
+@pytest.mark.parametrize("name", CLASSICAL)
+def test_classical_is_deterministic(name: str) -> None:
+    a = _run(name, seed=3, map_name="room")
+    b = _run(name, seed=3, map_name="room")
+    assert a[1] == b[1] and a[0]["travel"] == b[0]["travel"]
+
+
+def test_classical_are_declared_for_v1_and_offered_to_compare() -> None:
+    offered = available_policies(ENV_ID)
+    for name in CLASSICAL:
+        assert name in offered
+    assert not set(CLASSICAL) & set(available_policies("motiongym/Sweeper-v0"))
