@@ -17,6 +17,7 @@ POLICIES: dict[str, dict[str, str]] = {
         "nearest-unswept": "motiongym.baselines.sweeper.nearest:NearestUnsweptPolicy",
         # the field's classical coverage references, online on the robot's own map
         "boustrophedon": "motiongym.baselines.sweeper.boustrophedon:BoustrophedonPolicy",
+        "ba-star": "motiongym.baselines.sweeper.ba_star:BaStarPolicy",
     },
 }
 

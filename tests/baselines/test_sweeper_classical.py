@@ -17,12 +17,14 @@ import motiongym  # noqa: F401
 from motiongym.agents.evaluation.episodes import run_episode
 from motiongym.agents.models.predictors import available_policies
 from motiongym.baselines.registry import make_policy
+from motiongym.baselines.sweeper import ba_star
 from motiongym.baselines.sweeper import boustrophedon as bcd
+from motiongym.baselines.sweeper.online import astar
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.generator import empty_room
 
 ENV_ID = "motiongym/Sweeper-v1"
-CLASSICAL = ("boustrophedon",)
+CLASSICAL = ("boustrophedon", "ba-star")
 
 
 def _run(name: str, seed: int = 0, options: dict | None = None, **kwargs: Any):
@@ -96,6 +98,82 @@ def test_boustrophedon_lanes_alternate_in_a_cell_and_cells_open_at_critical_poin
     # a cell the split opened lies beside the pillar (rows 9-14), above or below it
     split = [interval for e, _, interval, _ in diag["cells"] if e == "split"]
     assert all(hi <= 6 or lo >= 15 for lo, hi in split)
+
+
+# ----------------------------------------------------------------------- BA*
+def test_ba_star_backtracking_value_counts_corners_of_uncovered_regions() -> None:
+    """Eq. 3 on s1 .. s8 (E, NE, N, NW, W, SW, S, SE; True: free and not covered)."""
+    assert ba_star.b_value((False,) * 8) == 0
+    assert ba_star.b_value((True,) * 8) == 0  # free all round: no corner
+    east = (True, False, False, False, False, False, False, False)
+    assert ba_star.b_value(east) == 2  # mu(s1, s8) + mu(s1, s2)
+    west_open_below = (False, False, False, True, True, False, False, False)
+    assert ba_star.b_value(west_open_below) == 1  # mu(s5, s6) only: s4 is free
+    south = (False, False, False, False, False, True, True, True)
+    assert ba_star.b_value(south) == 0  # s7 free but s6 and s8 free too
+    north_only = (False, False, True, False, False, False, False, False)
+    assert ba_star.b_value(north_only) == 0  # s3 is not a term of eq. 3
+
+
+def test_ba_star_motion_checks_north_south_east_west_in_order() -> None:
+    assert ba_star.bm_direction({1: True, 3: True, 0: True}) == 1
+    assert ba_star.bm_direction({3: True, 0: True, 2: True}) == 3
+    assert ba_star.bm_direction({0: True, 2: True}) == 0
+    assert ba_star.bm_direction({2: True}) == 2
+    assert ba_star.bm_direction({0: False}) is None
+
+
+def test_astar_is_shortest_and_smoothing_keeps_its_length_with_fewer_turns() -> None:
+    """A* against the breadth-first distance on the apartment's configurations; a
+    staircase smoothed to one L (same length, one turn); around a wall the smoothed path
+    stays on free cells."""
+    from motiongym.envs.sweeper.maps import shipped_map
+
+    free = occupancy.config_free(shipped_map("apartment"), 3)
+    cells = np.argwhere(free)
+    rng = np.random.default_rng(5)
+    for _ in range(8):
+        a, b = (tuple(int(v) for v in cells[rng.integers(len(cells))]) for _ in range(2))
+        dist = occupancy.bfs_distance(free, a)[b]
+        path = astar(free, a, b)
+        assert (path is None) == (dist < 0)
+        if path is not None:
+            assert len(path) == dist
+    open_ = np.ones((6, 6), bool)
+    stair = [(0, 1), (1, 1), (1, 2), (2, 2), (2, 3), (3, 3)]
+    smoothed = ba_star.smooth(stair, (0, 0), open_)
+    assert len(smoothed) == 6 and smoothed[-1] == (3, 3)
+    turns = sum(
+        (b[0] - a[0], b[1] - a[1]) != (c[0] - b[0], c[1] - b[1])
+        for a, b, c in zip([(0, 0), *smoothed[:-2]], smoothed[:-1], smoothed[1:], strict=True)
+    )
+    assert turns == 1
+    walled = open_.copy()
+    walled[0:4, 2] = False
+    path = astar(walled, (0, 0), (0, 4))
+    assert path is not None
+    smoothed = ba_star.smooth(path, (0, 0), walled)
+    assert len(smoothed) == len(path) and all(walled[p] for p in smoothed)
+    for p, q in zip([(0, 0), *smoothed[:-1]], smoothed, strict=True):
+        assert abs(p[0] - q[0]) + abs(p[1] - q[1]) == 1
+
+
+def test_ba_star_goes_north_first_and_backtracks_to_the_nearest_point_of_its_list() -> None:
+    """Pillar room, start heading east: the first move is north (BM's priority); at each
+    critical point the point chosen is on the backtracking list ``L`` and no point of
+    ``L`` is nearer (moves in the true free space, which the robot's map matches here
+    where it has swept), the A* path is smoothed without growing; the room is swept."""
+    grid = _pillar_room()
+    info, _, diag, state = _run("ba-star", options={"start": (18, 2), "heading": 0}, grid=grid)
+    assert info["coverage"] == 1.0 and info["bumps"] == 0
+    assert state.path[1] == (17, 2)  # north
+    assert diag["backtracks"]
+    free = occupancy.config_free(grid, 3)
+    for cp, L, chosen, a_len, smoothed in diag["backtracks"]:
+        assert chosen in L
+        dist = occupancy.bfs_distance(free, cp)
+        assert dist[chosen] == min(dist[s] for s in L)
+        assert len(smoothed) == a_len == dist[chosen]
 
 
 # ------------------------------------------------------------------ all of them
