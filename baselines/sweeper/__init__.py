@@ -18,6 +18,7 @@ POLICIES: dict[str, dict[str, str]] = {
         # the field's classical coverage references, online on the robot's own map
         "boustrophedon": "motiongym.baselines.sweeper.boustrophedon:BoustrophedonPolicy",
         "ba-star": "motiongym.baselines.sweeper.ba_star:BaStarPolicy",
+        "spiral-stc": "motiongym.baselines.sweeper.spiral_stc:SpiralStcPolicy",
     },
 }
 

@@ -19,6 +19,7 @@ from motiongym.agents.models.predictors import available_policies
 from motiongym.baselines.registry import make_policy
 from motiongym.baselines.sweeper import ba_star
 from motiongym.baselines.sweeper import boustrophedon as bcd
+from motiongym.baselines.sweeper import spiral_stc as stc
 from motiongym.baselines.sweeper.online import astar
 from motiongym.envs.sweeper import occupancy
 from motiongym.envs.sweeper.generator import empty_room
@@ -176,6 +177,103 @@ def test_ba_star_goes_north_first_and_backtracks_to_the_nearest_point_of_its_lis
         assert len(smoothed) == a_len == dist[chosen]
 
 
+# ----------------------------------------------------------------- Spiral-STC
+def test_stc_step_goes_round_a_cell_counterclockwise_and_crosses_tree_edges() -> None:
+    """Without edges the robot goes NE -> NW -> SW -> SE -> NE round its cell; a tree edge
+    (or a new free neighbour, which grows one) takes it across, beside the edge."""
+    tree: set[frozenset] = set()
+    x, q = (0, 0), stc.NE
+    seen = []
+    for _ in range(4):
+        x, q, grew = stc.next_step(x, q, tree, lambda y: False)
+        seen.append((x, q, grew))
+    assert seen == [((0, 0), stc.NW, False), ((0, 0), stc.SW, False),
+                    ((0, 0), stc.SE, False), ((0, 0), stc.NE, False)]  # fmt: skip
+    # the NE quadrant looks north: a new free cell there becomes a child
+    assert stc.next_step((0, 0), stc.NE, tree, lambda y: y == (-1, 0)) == ((-1, 0), stc.SE, True)
+    assert frozenset(((0, 0), (-1, 0))) in tree
+    # and the child's SW quadrant crosses the same edge back to the parent's NW
+    assert stc.next_step((-1, 0), stc.SW, tree, lambda y: False) == ((0, 0), stc.NW, False)
+
+
+def _free_cells_from_start(grid: np.ndarray, origin: tuple[int, int], w: int = 3) -> set:
+    """Oracle: the 2w x 2w cells of the grid anchored at ``origin`` that are free in the
+    true map and 4-connected to cell (0, 0) through free ones."""
+    h, wd = grid.shape
+
+    def free(i: int, j: int) -> bool:
+        r0, c0 = origin[0] + 2 * w * i, origin[1] + 2 * w * j
+        return (
+            r0 >= 0
+            and c0 >= 0
+            and r0 + 2 * w <= h
+            and c0 + 2 * w <= wd
+            and not (grid[r0 : r0 + 2 * w, c0 : c0 + 2 * w].any())
+        )
+
+    seen, stack = {(0, 0)}, [(0, 0)]
+    while stack:
+        x = stack.pop()
+        for dr, dc in ((0, 1), (1, 0), (0, -1), (-1, 0)):
+            y = (x[0] + dr, x[1] + dc)
+            if y not in seen and free(*y):
+                seen.add(y)
+                stack.append(y)
+    return seen
+
+
+@pytest.mark.parametrize(
+    ("grid", "start", "expected"),
+    [(empty_room(26, 26), (1, 1), 16), (_pillar_room(), (1, 1), None)],
+    ids=["empty", "pillar"],
+)
+def test_stc_tree_spans_every_free_cell_and_the_robot_goes_round_it_once(
+    grid, start, expected
+) -> None:
+    """The spanning tree holds every free 2D cell connected to the start cell (an
+    oracle on the true map) and is a tree (cells - 1 edges, connected); the robot
+    steps into every free sub-cell of it exactly once and ends where it started (or
+    the episode ends first, on full coverage)."""
+    info, _, diag, state = _run("spiral-stc", options={"start": start, "heading": 0}, grid=grid)
+    cells = {tuple(x) for x in diag["cells"]}
+    oracle = _free_cells_from_start(grid, diag["origin"])
+    assert oracle <= cells and (expected is None or len(cells) == expected)
+    assert len(diag["tree"]) == len(cells) - 1
+    joined = {next(iter(cells))}
+    for _ in cells:
+        joined |= {b for a, b in diag["tree"] if a in joined} | {
+            a for a, b in diag["tree"] if b in joined
+        }
+    assert joined == cells
+    visits = [(tuple(x), q) for x, q in diag["visits"]]
+    back = diag["done"]  # the tour ended (not the episode, on full coverage, before)
+    assert not back or visits[-1] == visits[0]
+    assert len(set(visits)) == len(visits) - back
+    cfree = occupancy.config_free(grid, 3)
+    for x in cells:
+        for q in range(4):
+            r, c = (
+                diag["origin"][0] + 6 * x[0] + 3 * stc.OFFSET[q][0],
+                diag["origin"][1] + 6 * x[1] + 3 * stc.OFFSET[q][1],
+            )
+            assert ((x, q) in visits) == bool(cfree[r, c])
+    assert (state.row, state.col) == start if back else info["is_success"]
+    if expected is not None:
+        assert info["coverage"] == 1.0  # a room tiled exactly by 2D cells
+
+
+@pytest.mark.parametrize("map_name", ["room", "apartment", "maze"])
+def test_stc_covers_the_free_2d_cells_of_the_shipped_maps_and_leaves_the_rest(map_name) -> None:
+    """Shipped maps (seed 0): every free 2D cell connected to the start cell is in the tree
+    and the tour ends at the start; the floor in cells partly occupied is left, so
+    coverage stays below 1 (docs/experiments/Sweeper-v1.md)."""
+    info, _, diag, state = _run("spiral-stc", seed=0, map_name=map_name)
+    oracle = _free_cells_from_start(state.scenario.obstacle, diag["origin"])
+    assert oracle <= {tuple(x) for x in diag["cells"]}
+    assert diag["done"] and (state.row, state.col) == state.path[0]
+    assert info["bumps"] == 0 and 0.0 < info["coverage"] < 1.0
+
+
 # ------------------------------------------------------------------ all of them
 @pytest.mark.parametrize("name", CLASSICAL)
 @pytest.mark.parametrize("map_name", ["room", "apartment", "maze"])
@@ -185,7 +283,7 @@ def test_classical_sweeps_every_reachable_cell_of_the_shipped_maps(name, map_nam
     assert info["coverage"] == 1.0 and info["bumps"] == 0, (info["coverage"], info["bumps"])
 
 
-@pytest.mark.parametrize("name", CLASSICAL)
+@pytest.mark.parametrize("name", (*CLASSICAL, "spiral-stc"))
 def test_classical_is_deterministic(name: str) -> None:
     a = _run(name, seed=3, map_name="room")
     b = _run(name, seed=3, map_name="room")
@@ -194,6 +292,6 @@ def test_classical_is_deterministic(name: str) -> None:
 
 def test_classical_are_declared_for_v1_and_offered_to_compare() -> None:
     offered = available_policies(ENV_ID)
-    for name in CLASSICAL:
+    for name in (*CLASSICAL, "spiral-stc"):
         assert name in offered
-    assert not set(CLASSICAL) & set(available_policies("motiongym/Sweeper-v0"))
+    assert not {*CLASSICAL, "spiral-stc"} & set(available_policies("motiongym/Sweeper-v0"))
