@@ -13,8 +13,8 @@ under odometry error they trust the dead-reckoned ``pose`` (no localiser).
 one, then forward), asks the subclass's current mode for a new path or an
 action when the path is done, and reports ``mode``, ``done`` and ``log`` in
 ``diagnostics()``. :func:`astar` is a plain A* over a grid of free
-configurations (Hart, Nilsson & Raphael 1968), used by BA* and by the
-transfers between cells and subtrees.
+configurations (Hart, Nilsson & Raphael 1968), BA*'s planner; the
+transfers between cells and sub-cells use the quadtree of :mod:`.quadtree`.
 """
 
 from __future__ import annotations
