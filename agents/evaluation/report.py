@@ -273,12 +273,13 @@ def plotted_measures(evaluations: list[Evaluation]) -> list[str]:
 
 def _bar_errors(means: list[float], lows: list[float], highs: list[float], unit: str) -> np.ndarray:
     """Lower and upper error-bar lengths of the intervals ``[low, high]`` (a rate's lie in
-    [0, 1] already), a count's or duration's clipped at 0."""
+    [0, 1] already), a count's or duration's clipped at 0. A length is never negative:
+    a rate of 0 has a Wilson bound of about 1e-17 above it, in rounding."""
     means_ = np.asarray(means)
     lower, upper = means_ - np.asarray(lows), np.asarray(highs) - means_
     if unit in COUNT_UNITS:
         lower = np.minimum(lower, means_)
-    return np.vstack([lower, upper])
+    return np.maximum(np.vstack([lower, upper]), 0.0)
 
 
 def comparison_figure(evaluations: list[Evaluation], path: Path) -> Path:

@@ -15,6 +15,10 @@ POLICIES: dict[str, dict[str, str]] = {
         **_SWEEPER_POLICIES,
         # a teacher for learned agents (a function of the maps and pose; not the paper's)
         "nearest-unswept": "motiongym.baselines.sweeper.nearest:NearestUnsweptPolicy",
+        # the field's classical coverage references, online on the robot's own map
+        "boustrophedon": "motiongym.baselines.sweeper.boustrophedon:BoustrophedonPolicy",
+        "ba-star": "motiongym.baselines.sweeper.ba_star:BaStarPolicy",
+        "spiral-stc": "motiongym.baselines.sweeper.spiral_stc:SpiralStcPolicy",
     },
 }
 

@@ -111,6 +111,8 @@ def test_figures_omit_measures_always_zero_or_repeated_and_clip_rates():
     errors = _bar_errors([2.0, -1.0], [-1.0, -4.0], [5.0, 2.0], "m")  # may be negative
     np.testing.assert_allclose(errors, [[3.0, 3.0], [3.0, 3.0]])
     np.testing.assert_allclose(_bar_errors([2.0], [-1.0], [5.0], "steps"), [[2.0], [3.0]])
+    # a rate of 0 whose Wilson bound lies 5.6e-17 above it (spiral-stc's in compare)
+    assert (_bar_errors([0.0], [5.551e-17], [0.5615], "rate") >= 0).all()
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
